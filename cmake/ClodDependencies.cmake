@@ -1,0 +1,21 @@
+# Every third-party dependency of clod, found in one place. All come from Debian packages.
+find_package(Eigen3 3.4 REQUIRED NO_MODULE)
+find_package(TBB REQUIRED)
+find_package(assimp REQUIRED)
+find_package(nlohmann_json 3.10 REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(Qhull REQUIRED)   # Delaunay tetrahedralisation for the medial-axis sphere-tree builder
+find_package(Threads REQUIRED)
+
+if(CLOD_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()
+if(CLOD_BUILD_BENCHMARKS)
+  find_package(benchmark REQUIRED)
+  # Peers for side-by-side comparisons; each one is optional.
+  find_package(CGAL QUIET)
+  find_package(embree 3 QUIET)
+  find_package(fcl QUIET)
+  find_package(Bullet QUIET)
+  find_package(OpenVDB QUIET PATHS /usr/lib/x86_64-linux-gnu/cmake/OpenVDB)
+endif()

@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Installs the Debian packages clod needs (only the missing ones). Run as root.
+#   scripts/install-deps.sh            build + test dependencies
+#   scripts/install-deps.sh --peers    also the comparison peers used by bench/ (CGAL, Embree, FCL, Bullet, OpenVDB)
+#   scripts/install-deps.sh --fuzz     also clang and its libFuzzer runtime
+set -euo pipefail
+packages=(build-essential cmake ninja-build pkg-config
+  libeigen3-dev libassimp-dev libtbb-dev nlohmann-json3-dev libcli11-dev libqhull-dev
+  libgtest-dev libgmock-dev libbenchmark-dev)
+for arg in "$@"; do
+  case "$arg" in
+    --peers) packages+=(libcgal-dev libembree-dev libfcl-dev libbullet-dev libopenvdb-dev) ;;
+    --fuzz) packages+=(clang libclang-rt-14-dev) ;;
+    *) echo "install-deps.sh: unknown option $arg" >&2; exit 2 ;;
+  esac
+done
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "install-deps.sh: installing ${missing[*]}"
+  sudo_cmd=""
+  [ "$(id -u)" -eq 0 ] || sudo_cmd="sudo"
+  $sudo_cmd apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# The README's test command: install missing packages, build (Release), run the whole test suite.
+# With --sanitize, a second build under AddressSanitizer + UndefinedBehaviorSanitizer runs it too.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/install-deps.sh
+jobs=$(nproc)
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCLOD_BUILD_TESTS=ON
+cmake --build build -j "$jobs"
+ctest --test-dir build -j "$jobs" --output-on-failure
+if [[ "${1:-}" == "--sanitize" ]]; then
+  cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCLOD_SANITIZE=ON -DCLOD_BUILD_TESTS=ON
+  cmake --build build-asan -j "$jobs"
+  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 CLOD_TEST_SCALE=sanitizer \
+    ctest --test-dir build-asan -j "$jobs" --output-on-failure
+fi
