@@ -6,6 +6,8 @@ find_package(nlohmann_json 3.10 REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(Qhull REQUIRED)   # Delaunay tetrahedralisation for the medial-axis sphere-tree builder
 find_package(Threads REQUIRED)
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)  # section checksums of the bake file (XXH3-64)
 
 if(CLOD_BUILD_TESTS)
   find_package(GTest REQUIRED)
