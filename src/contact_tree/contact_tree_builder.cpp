@@ -1,0 +1,270 @@
+#include "clod/contact_tree_builder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "clod/error.h"
+#include "clod/proximity.h"
+#include "lattice.h"
+
+namespace clod {
+namespace {
+
+using detail::childCornerLattice;
+using detail::kLatticeSize;
+using detail::kLatticeSlot;
+
+constexpr double kSqrt3 = 1.7320508075688772;
+// The interpolation error peaks between test points where the field has a kink (medial axis,
+// sharp edges) or curvature varies: a 1-D kink at a quarter of the spacing already peaks 1.5x
+// above the nearest samples. Measured errors are therefore inflated by this factor, both for
+// the refinement test (measured <= eps / kGapFactor) and for the stored bound (kGapFactor *
+// measured, capped by the rigorous half-diagonal). docs/contact-tree.md has the measurements.
+constexpr double kGapFactor = 2.0;
+
+// A cell waiting to be processed: where it is and its (float-rounded, exact) corner values.
+struct PendingCell {
+  std::uint32_t index[3];
+  std::array<float, 8> corners;
+};
+
+// What processing one cell decided. Written by one TBB task, read by the serial linking pass.
+struct CellResult {
+  bool split = false;
+  bool surface = false;
+  bool measured = false;
+  bool discontinuous = false;
+  bool aboveError = false;
+  float error = 0.0f;
+  float bandError = 0.0f;
+  std::uint32_t queries = 0;
+  ContactHalfSpace halfSpace{};
+  std::array<float, kLatticeSize> lattice{};
+};
+
+void checkSettings(const ContactTreeSettings& s) {
+  auto bad = [](const std::string& what) { throw Error(ErrorCode::kInvalidArgument, "contact tree settings: " + what); };
+  if (!(std::isfinite(s.errorRel) && s.errorRel > 0.0))
+    bad("errorRel " + std::to_string(s.errorRel) + " must be finite and > 0");
+  if (s.maxDepth < 1 || s.maxDepth > 20) bad("maxDepth " + std::to_string(s.maxDepth) + " must be in 1..20");
+  if (!(std::isfinite(s.bandRel) && s.bandRel >= 0.0))
+    bad("bandRel " + std::to_string(s.bandRel) + " must be finite and >= 0");
+  if (!(std::isfinite(s.cubeMarginRel) && s.cubeMarginRel > s.bandRel && s.cubeMarginRel <= 10.0))
+    bad("cubeMarginRel " + std::to_string(s.cubeMarginRel) + " must be finite, > bandRel and <= 10");
+  if (!(std::isfinite(s.discontinuityStopRel) && s.discontinuityStopRel >= 0.0))
+    bad("discontinuityStopRel " + std::to_string(s.discontinuityStopRel) + " must be finite and >= 0");
+}
+
+class Builder {
+public:
+  Builder(const MeshDistance& distance, const ContactTreeSettings& settings) : distance_(distance), settings_(settings) {}
+
+  ContactTree build(ContactTreeBuildStats* stats);
+
+private:
+  void processCell(const PendingCell& cell, std::uint32_t depth, CellResult& result) const;
+
+  const MeshDistance& distance_;
+  const ContactTreeSettings& settings_;
+  ContactTree tree_;
+};
+
+void Builder::processCell(const PendingCell& cell, std::uint32_t depth, CellResult& r) const {
+  const double h = tree_.cellSize(depth);
+  const double diagonal = kSqrt3 * h;
+  const double band = tree_.bandAbs;
+  const Vec3 cellMin = tree_.origin + h * Vec3(cell.index[0], cell.index[1], cell.index[2]);
+
+  float minAbs = std::abs(cell.corners[0]);
+  bool sameSign = true;
+  for (int c = 1; c < 8; ++c) {
+    minAbs = std::min(minAbs, std::abs(cell.corners[c]));
+    sameSign = sameSign && ((cell.corners[c] < 0.0f) == (cell.corners[0] < 0.0f));
+  }
+  // Lipschitz: every point x of the cell is within one diagonal of every corner, so
+  // |d(x)| >= |d(corner)| - diagonal. If all corners exceed band + diagonal, no point of the
+  // cell is in the band and the surface does not cross it. The relative slack covers the
+  // float rounding of the corner values.
+  if (sameSign && double(minAbs) * (1.0 - 1e-6) > band + diagonal) {
+    // Rigorous for any 1-Lipschitz field: |d(x) - sum w_i d(c_i)| <= sum w_i |x - c_i| <=
+    // sqrt(sum w_i |x - c_i|^2) = h sqrt(sum_axes t(1-t)) <= h sqrt(3)/2.
+    r.error = static_cast<float>(0.5 * diagonal);
+    return;
+  }
+
+  // Exact values at the 27 lattice points (8 known) and at the 8 octant centres.
+  r.measured = true;
+  double exact[kLatticeSize];
+  MeshDistance::Signed centre{};
+  for (int l = 0; l < kLatticeSize; ++l) {
+    const int i = l % 3, j = (l / 3) % 3, k = l / 9;
+    if (kLatticeSlot[l] < 0) {
+      const int c = (i / 2) | ((j / 2) << 1) | ((k / 2) << 2);
+      exact[l] = cell.corners[c];
+      continue;
+    }
+    const Vec3 p = cellMin + 0.5 * h * Vec3(i, j, k);
+    if (l == 13) {
+      centre = distance_.signedQuery(p);
+      exact[l] = centre.signedDistance;
+    } else {
+      exact[l] = distance_.signedDistance(p);
+    }
+    ++r.queries;
+  }
+  double octantCentre[8];
+  for (int o = 0; o < 8; ++o) {
+    const Vec3 t(0.25 + 0.5 * (o & 1), 0.25 + 0.5 * ((o >> 1) & 1), 0.25 + 0.5 * ((o >> 2) & 1));
+    octantCentre[o] = distance_.signedDistance(cellMin + h * t);
+    ++r.queries;
+  }
+
+  // Interpolation error at the test points, overall and restricted to the band. A band point
+  // is within 0.28 h of a test point (covering radius of this body-centred lattice), so a
+  // test point counts for the band if |d| <= band + h/2.
+  const double bandTest = band + 0.5 * h;
+  double error = 0.0, bandError = 0.0;
+  auto account = [&](const Vec3& t, double exactValue) {
+    const double e = std::abs(interpolateTrilinear(cell.corners, t, nullptr) - exactValue);
+    error = std::max(error, e);
+    if (std::abs(exactValue) <= bandTest) bandError = std::max(bandError, e);
+  };
+  for (int l = 0; l < kLatticeSize; ++l)
+    if (kLatticeSlot[l] >= 0) account(0.5 * Vec3(l % 3, (l / 3) % 3, l / 9), exact[l]);
+  for (int o = 0; o < 8; ++o)
+    account(Vec3(0.25 + 0.5 * (o & 1), 0.25 + 0.5 * ((o >> 1) & 1), 0.25 + 0.5 * ((o >> 2) & 1)), octantCentre[o]);
+
+  // A distance is 1-Lipschitz; lattice neighbours (h/2 apart) differing by more reveal a sign
+  // discontinuity (winding-number membrane over a hole, or a sign tie) that no refinement fixes.
+  const double lipschitz = 0.5 * h * (1.0 + 1e-4) + 1e-6 * (std::abs(exact[13]) + diagonal);
+  for (int l = 0; l < kLatticeSize && !r.discontinuous; ++l) {
+    const int i = l % 3, j = (l / 3) % 3, k = l / 9;
+    if (i < 2 && std::abs(exact[l] - exact[l + 1]) > lipschitz) r.discontinuous = true;
+    if (j < 2 && std::abs(exact[l] - exact[l + 3]) > lipschitz) r.discontinuous = true;
+    if (k < 2 && std::abs(exact[l] - exact[l + 9]) > lipschitz) r.discontinuous = true;
+  }
+
+  // Measured values cannot exceed the rigorous Lipschitz bound unless the field jumps.
+  r.error = static_cast<float>(r.discontinuous ? kGapFactor * error : std::min(kGapFactor * error, 0.5 * diagonal));
+  r.bandError = static_cast<float>(bandError);
+  for (int l = 0; l < kLatticeSize; ++l) r.lattice[l] = static_cast<float>(exact[l]);
+
+  // The surface crosses the cell iff some point of it has d = 0; every point is within half a
+  // diagonal of the centre, so |d(centre)| <= diagonal/2 is necessary (and with a sign change
+  // on the lattice, sufficient). Cells that pass get a half-space: the first-order Taylor plane
+  // of d at the centre, d(x) ~ d(c) + grad d(c) . (x - c), whose gradient is the unit vector
+  // from the closest point to the centre (outward), or the closest feature's normal when the
+  // centre is on the surface. For a convex patch this plane supports the body.
+  bool signChange = false;
+  for (int l = 1; l < kLatticeSize; ++l) signChange = signChange || ((exact[l] < 0.0) != (exact[0] < 0.0));
+  const double dc = centre.signedDistance;
+  if (std::abs(dc) <= 0.5 * diagonal * (1.0 + 1e-9) || signChange) {
+    r.surface = true;
+    Vec3 n = centre.closest.normal;
+    const Vec3 toCentre = (cellMin + Vec3::Constant(0.5 * h)) - centre.closest.point;
+    if (std::abs(dc) > 1e-9 * diagonal && toCentre.norm() > 0.0) n = toCentre / dc;
+    if (!(n.norm() > 0.5)) n = Vec3::UnitZ();  // degenerate feature: any unit normal, fitError says how bad
+    n.normalize();
+    double fit = 0.0;
+    for (int l = 0; l < kLatticeSize; ++l) {
+      if (std::abs(exact[l]) > diagonal) continue;
+      const Vec3 offset = 0.5 * h * Vec3((l % 3) - 1.0, ((l / 3) % 3) - 1.0, (l / 9) - 1.0);
+      fit = std::max(fit, std::abs(n.dot(offset) + dc - exact[l]));
+    }
+    r.halfSpace.normal = {static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z())};
+    r.halfSpace.offset = static_cast<float>(-dc);
+    r.halfSpace.fitError = static_cast<float>(fit);
+  }
+
+  const bool canSplit = depth < settings_.maxDepth &&
+                        (!r.discontinuous || diagonal > settings_.discontinuityStopRel * tree_.meshDiagonal);
+  const bool overError = kGapFactor * bandError > tree_.errorAbs;
+  r.split = overError && canSplit;
+  r.aboveError = !r.split && overError && !r.discontinuous;
+}
+
+ContactTree Builder::build(ContactTreeBuildStats* stats) {
+  const Aabb box = distance_.mesh().bounds();
+  const double diag = box.diagonal();
+  tree_.meshDiagonal = diag;
+  tree_.errorAbs = settings_.errorRel * diag;
+  tree_.bandAbs = settings_.bandRel * diag;
+  tree_.maxDepth = settings_.maxDepth;
+  const double margin = settings_.cubeMarginRel * diag;
+  tree_.rootSize = box.extent().maxCoeff() + 2.0 * margin;
+  tree_.origin = box.center() - Vec3::Constant(0.5 * tree_.rootSize);
+
+  ContactTreeBuildStats st;
+  std::vector<PendingCell> frontier(1);
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 corner = tree_.origin + tree_.rootSize * Vec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+    frontier[0].corners[c] = static_cast<float>(distance_.signedDistance(corner));
+    ++st.distanceQueries;
+  }
+  tree_.rootCorners = frontier[0].corners;
+  frontier[0].index[0] = frontier[0].index[1] = frontier[0].index[2] = 0;
+
+  std::vector<CellResult> results;
+  std::vector<PendingCell> next;
+  tree_.levelOffsets.push_back(0);
+  for (std::uint32_t depth = 0; !frontier.empty(); ++depth) {
+    results.assign(frontier.size(), CellResult{});
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, frontier.size(), 8), [&](const tbb::blocked_range<std::size_t>& range) {
+      for (std::size_t i = range.begin(); i != range.end(); ++i) processCell(frontier[i], depth, results[i]);
+    });
+    // Link serially in frontier order: children are appended in the same order as their
+    // parents, which keeps the layout breadth-first and independent of scheduling.
+    next.clear();
+    for (std::size_t i = 0; i < frontier.size(); ++i) {
+      const CellResult& r = results[i];
+      st.distanceQueries += r.queries;
+      st.measuredCells += r.measured;
+      st.discontinuousCells += r.discontinuous;
+      tree_.errorBound.push_back(r.error);
+      if (r.surface) {
+        tree_.halfSpaceIndex.push_back(static_cast<std::uint32_t>(tree_.halfSpaces.size()));
+        tree_.halfSpaces.push_back(r.halfSpace);
+      } else {
+        tree_.halfSpaceIndex.push_back(kNoHalfSpace);
+      }
+      if (!r.split) {
+        tree_.firstChild.push_back(0);
+        ++st.leaves;
+        st.leavesAboveError += r.aboveError;
+        if (r.measured && !r.discontinuous) st.maxBandLeafError = std::max(st.maxBandLeafError, double(r.bandError));
+        continue;
+      }
+      const std::size_t firstChild = tree_.levelOffsets.back() + frontier.size() + next.size();
+      if (firstChild + 8 > 0xfffffff0u) throw Error(ErrorCode::kUnsupportedMesh, "contact tree: more than 2^32 nodes; raise errorRel or lower maxDepth");
+      tree_.firstChild.push_back(static_cast<std::uint32_t>(firstChild));
+      for (int l = 0; l < kLatticeSize; ++l)
+        if (kLatticeSlot[l] >= 0) tree_.lattice.push_back(r.lattice[l]);
+      for (int o = 0; o < 8; ++o) {
+        PendingCell child;
+        for (int a = 0; a < 3; ++a) child.index[a] = 2 * frontier[i].index[a] + ((o >> a) & 1);
+        for (int c = 0; c < 8; ++c) child.corners[c] = r.lattice[childCornerLattice(o, c)];
+        next.push_back(child);
+      }
+    }
+    tree_.levelOffsets.push_back(static_cast<std::uint32_t>(tree_.levelOffsets.back() + frontier.size()));
+    frontier.swap(next);
+  }
+  st.nodes = tree_.nodeCount();
+  st.surfaceCells = tree_.halfSpaces.size();
+  if (stats) *stats = st;
+  return std::move(tree_);
+}
+
+}  // namespace
+
+ContactTree buildContactTree(const MeshDistance& distance, const ContactTreeSettings& settings, ContactTreeBuildStats* stats) {
+  checkSettings(settings);
+  Builder builder(distance, settings);
+  return builder.build(stats);
+}
+
+}  // namespace clod

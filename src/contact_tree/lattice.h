@@ -1,0 +1,48 @@
+#pragma once
+// The 3x3x3 lattice of a split cell: lattice point (i, j, k), i, j, k in {0, 1, 2}, has linear
+// index i + 3j + 9k. The 8 points with all coordinates even are the cell's corners; the other
+// 19 are stored per interior node, in linear-index order ("pool slot").
+
+#include <array>
+#include <cstdint>
+
+namespace clod::detail {
+
+inline constexpr int kLatticeSize = 27;
+
+constexpr bool isCellCorner(int l) { return (l % 3) % 2 == 0 && ((l / 3) % 3) % 2 == 0 && (l / 9) % 2 == 0; }
+
+/// Linear lattice index of corner c (bits x, y, z) of child octant o.
+constexpr int childCornerLattice(int o, int c) {
+  return ((o & 1) + (c & 1)) + 3 * (((o >> 1) & 1) + ((c >> 1) & 1)) + 9 * (((o >> 2) & 1) + ((c >> 2) & 1));
+}
+
+/// Linear lattice index of the parent's corner c.
+constexpr int parentCornerLattice(int c) { return 2 * (c & 1) + 6 * ((c >> 1) & 1) + 18 * ((c >> 2) & 1); }
+
+/// Pool slot (0..18) of each lattice point, -1 for the 8 cell corners.
+constexpr std::array<int, kLatticeSize> makeLatticeSlots() {
+  std::array<int, kLatticeSize> slots{};
+  int next = 0;
+  for (int l = 0; l < kLatticeSize; ++l) slots[l] = isCellCorner(l) ? -1 : next++;
+  return slots;
+}
+inline constexpr std::array<int, kLatticeSize> kLatticeSlot = makeLatticeSlots();
+
+/// kChildCornerSlot[o][c]: pool slot of child o's corner c. The one corner a child shares with
+/// its parent (c == o) has no slot; it maps to slot 0 and the caller keeps the parent's value.
+constexpr std::array<std::array<std::uint8_t, 8>, 8> makeChildCornerSlots() {
+  std::array<std::array<std::uint8_t, 8>, 8> table{};
+  for (int o = 0; o < 8; ++o)
+    for (int c = 0; c < 8; ++c) {
+      const int slot = kLatticeSlot[childCornerLattice(o, c)];
+      table[o][c] = static_cast<std::uint8_t>(slot < 0 ? 0 : slot);
+    }
+  return table;
+}
+inline constexpr std::array<std::array<std::uint8_t, 8>, 8> kChildCornerSlot = makeChildCornerSlots();
+
+static_assert(kLatticeSlot[25] == 18 && kLatticeSlot[26] == -1, "19 slots");
+static_assert(childCornerLattice(7, 7) == 26 && childCornerLattice(0, 0) == 0);
+
+}  // namespace clod::detail
