@@ -2,6 +2,7 @@
 // Loading triangle meshes from files: OBJ, STL (ASCII and binary), PLY, OFF, glTF/GLB,
 // read through Assimp, triangulated, welded and checked.
 
+#include <cstdint>
 #include <filesystem>
 #include <span>
 #include <string>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "clod/mesh.h"
+#include "clod/mesh_validation.h"
 
 namespace clod {
 
@@ -23,10 +25,23 @@ struct MeshLoadOptions {
 
 /// A loaded mesh plus what the loader had to say about it.
 struct LoadedMesh {
+  /// All triangles of all meshes of all nodes of the file, node transforms applied, polygons
+  /// triangulated, vertices welded, orientation fixed if asked. Degenerate and duplicate
+  /// triangles are kept (counted in `report`); points and lines in the file are ignored.
   TriangleMesh mesh;
   /// Non-fatal findings: open, non-manifold, degenerate or duplicate triangles, flipped
-  /// orientation, welded vertices... One human-readable line each.
+  /// orientation, ignored points/lines... One human-readable line each.
   std::vector<std::string> warnings;
+  /// validateMesh of `mesh` as returned (after welding and flipping); always usable().
+  MeshReport report;
+  /// Vertex count as the importer delivered it, before welding (STL: 3 per triangle).
+  std::uint32_t importedVertexCount = 0;
+  /// Vertices removed by welding (importedVertexCount - mesh.vertexCount()).
+  std::uint32_t weldedVertexCount = 0;
+  /// Absolute weld tolerance used: weldToleranceRel * bounding-box diagonal (0 when disabled).
+  double weldToleranceAbs = 0.0;
+  /// True when the mesh was inside-out and every triangle was flipped (a warning says so too).
+  bool flipped = false;
 };
 
 /// Loads a mesh file. Throws clod::Error naming the culprit for: a missing or unreadable
@@ -35,9 +50,24 @@ struct LoadedMesh {
 /// (kNonFiniteVertex), out-of-range indices (kIndexOutOfRange), no triangles
 /// (kNoTriangles), or only zero-area triangles (kAllTrianglesDegenerate).
 /// Open, non-manifold and flat meshes load, with warnings.
+///
+/// Pipeline: Assimp import with triangulation only (no vertex joining, no degenerate removal,
+/// no normal fixing: counts stay honest) -> merge all meshes of all nodes with their node
+/// transforms -> check coordinates and indices -> weld (weldVertices with
+/// weldToleranceRel * diagonal) -> validateMesh -> throw if unusable -> flip if inside-out.
+/// Nothing is printed: Assimp's log is captured, and its messages about repaired data (e.g. an
+/// out-of-range index the OFF reader would clamp, a glTF face it would drop) become errors,
+/// the rest become warnings prefixed "importer: ".
+/// Precision: Assimp (as packaged) stores positions in single precision, so coordinates are
+/// rounded to float before they become doubles here. Vertices that no face uses are not kept
+/// by Assimp's OBJ reader (stanford-bunny.obj: 35,947 `v` lines, 34,834 used).
 LoadedMesh loadMesh(const std::filesystem::path& path, const MeshLoadOptions& options = {});
 
-/// Same as loadMesh, from bytes in memory; `formatHint` is a file extension such as "obj".
+/// Same as loadMesh, from bytes in memory; `formatHint` is a file extension such as "obj",
+/// "stl", "ply", "off", "gltf", "glb" (letters and digits, at most 15; otherwise
+/// kInvalidArgument). A .gltf that refers to external .bin/.png files cannot resolve them from
+/// memory (kParseError); embedded (data URI) buffers and .glb work.
+/// Thread safety: both functions may run concurrently (each call uses its own importer).
 LoadedMesh loadMeshFromMemory(std::span<const std::byte> bytes, std::string_view formatHint,
                               const MeshLoadOptions& options = {});
 

@@ -1,0 +1,302 @@
+#include "clod/mesh_io.h"
+
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <utility>
+
+#include <assimp/DefaultLogger.hpp>
+#include <assimp/Importer.hpp>
+#include <assimp/LogStream.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include "clod/error.h"
+#include "clod/atomic_file.h"
+#include "clod/mesh_weld.h"
+#include "text_index_check.h"
+
+namespace clod {
+
+namespace {
+
+// Only triangulation. Deliberately absent: JoinIdenticalVertices (we weld with a tolerance),
+// FindDegenerates / FindInvalidData (they drop or alter triangles, hiding the counts we report),
+// FixInfacingNormals (it guesses; we orient by signed volume), ValidateDataStructure (its
+// findings arrive as log lines; we check ourselves), PreTransformVertices (we apply node
+// transforms ourselves, instancing meshes referenced by several nodes).
+constexpr unsigned kImportFlags = aiProcess_Triangulate;
+
+// Some Assimp importers repair bad data and only log it (the OFF reader clamps an out-of-range
+// index to the last vertex; the glTF reader drops faces with out-of-range indices). So every
+// import runs with a capturing log stream: those messages become errors or warnings instead of
+// silent changes. Assimp's logger is a process-wide singleton, hence the mutex: imports are
+// serialised (loading is not a hot path). Nothing is ever printed: without a logger of the
+// application's own, ours has no stream but the capturing one and is destroyed afterwards.
+class CapturedLog final : public Assimp::LogStream {
+public:
+  void write(const char* message) override {
+    std::string line = message ? message : "";
+    while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
+    // DefaultLogger prefixes "Error, T0: " / "Warn,  T0: "; keep the text after it.
+    const bool isError = line.starts_with("Error");
+    if (auto colon = line.find(": "); colon != std::string::npos && line.starts_with(isError ? "Error" : "Warn"))
+      line = line.substr(colon + 2);
+    if (messages_.size() < 64) messages_.push_back(line);
+  }
+  const std::vector<std::string>& messages() const { return messages_; }
+
+private:
+  std::vector<std::string> messages_;
+};
+
+std::mutex& importMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+// Runs `import` (which calls the importer) with a capturing logger attached.
+template <class ImportFn>
+const aiScene* importCapturingLog(Assimp::Importer& importer, CapturedLog& log, ImportFn&& import) {
+  std::lock_guard lock(importMutex());
+  const bool ownLogger = Assimp::DefaultLogger::isNullLogger();
+  if (ownLogger) Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);
+  Assimp::Logger* logger = Assimp::DefaultLogger::get();
+  logger->attachStream(&log, Assimp::Logger::Err | Assimp::Logger::Warn);
+  const aiScene* scene = nullptr;
+  try {
+    scene = import(importer);
+  } catch (...) {
+    // Assimp catches its own exceptions; this is only for std::bad_alloc and the like.
+    logger->detachStream(&log, Assimp::Logger::Err | Assimp::Logger::Warn);
+    if (ownLogger) Assimp::DefaultLogger::kill();
+    throw;
+  }
+  logger->detachStream(&log, Assimp::Logger::Err | Assimp::Logger::Warn);  // ownership returns to us
+  if (ownLogger) Assimp::DefaultLogger::kill();
+  return scene;
+}
+
+bool mentionsIndexOutOfRange(const std::string& message) {
+  return message.find("out of range") != std::string::npos || message.find("out-of-range") != std::string::npos;
+}
+
+// Assimp reports every failure as a string; "No suitable reader" is the only way to tell an
+// unknown format from a malformed file of a known format.
+[[noreturn]] void throwImportError(const std::string& source, const char* assimpMessage, std::string_view format,
+                                   std::string_view text) {
+  const std::string message = assimpMessage ? assimpMessage : "";
+  if (message.find("No suitable reader") != std::string::npos)
+    throw Error(ErrorCode::kUnknownFormat, source + ": unknown file format (" + message + ")");
+  if (mentionsIndexOutOfRange(message)) {
+    std::optional<std::string> where;
+    if (format == "obj") where = detail::findBadObjIndex(text);
+    if (format == "off") where = detail::findBadOffIndex(text);
+    throw Error(ErrorCode::kIndexOutOfRange, source + ": " + (where ? *where : message));
+  }
+  throw Error(ErrorCode::kParseError, source + ": " + (message.empty() ? std::string("import failed") : message));
+}
+
+// Turns what the importer logged into errors (index repairs) or warnings (everything else).
+void applyLog(const CapturedLog& log, const std::string& source, std::vector<std::string>& warnings) {
+  for (const std::string& message : log.messages()) {
+    if (mentionsIndexOutOfRange(message))
+      throw Error(ErrorCode::kIndexOutOfRange, source + ": " + message + " (the importer would have repaired it silently)");
+    warnings.push_back("importer: " + message);
+  }
+}
+
+std::string lowercase(std::string text) {
+  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return text;
+}
+
+struct Instance {
+  const aiNode* node;
+  aiMatrix4x4 transform;
+};
+
+LoadedMesh convertScene(const aiScene* scene, const CapturedLog& log, const std::string& source,
+                        const MeshLoadOptions& options) {
+  LoadedMesh result;
+  applyLog(log, source, result.warnings);
+  TriangleMesh& mesh = result.mesh;
+  std::uint64_t ignoredPrimitives = 0;
+  std::uint64_t totalVertices = 0, totalTriangles = 0;
+  constexpr std::uint64_t kMaxElements = std::numeric_limits<std::uint32_t>::max() - 1;
+
+  // Depth-first over the node graph with accumulated transforms; explicit stack, since a
+  // hostile file can nest nodes deeply.
+  std::vector<Instance> stack;
+  if (scene->mRootNode) stack.push_back({scene->mRootNode, scene->mRootNode->mTransformation});
+  while (!stack.empty()) {
+    const Instance instance = stack.back();
+    stack.pop_back();
+    const aiNode* node = instance.node;
+    for (unsigned c = 0; c < node->mNumChildren; ++c)
+      if (node->mChildren[c]) stack.push_back({node->mChildren[c], instance.transform * node->mChildren[c]->mTransformation});
+
+    const aiMatrix4x4& m = instance.transform;
+    // A mirroring transform reverses the winding; undo that so outward stays outward.
+    const double det3 = double(m.a1) * (double(m.b2) * m.c3 - double(m.b3) * m.c2) -
+                        double(m.a2) * (double(m.b1) * m.c3 - double(m.b3) * m.c1) +
+                        double(m.a3) * (double(m.b1) * m.c2 - double(m.b2) * m.c1);
+    const bool mirrored = det3 < 0.0;
+    const std::string nodeName = node->mName.length ? std::string(node->mName.C_Str()) : std::string("(unnamed)");
+
+    for (unsigned k = 0; k < node->mNumMeshes; ++k) {
+      const unsigned meshIndex = node->mMeshes[k];
+      if (meshIndex >= scene->mNumMeshes || !scene->mMeshes[meshIndex])
+        throw Error(ErrorCode::kParseError, source + ": node '" + nodeName + "' refers to mesh " +
+                                                std::to_string(meshIndex) + " of " + std::to_string(scene->mNumMeshes));
+      const aiMesh* in = scene->mMeshes[meshIndex];
+      const std::string where = source + ": mesh " + std::to_string(meshIndex) + " (node '" + nodeName + "')";
+      totalVertices += in->mNumVertices;
+      if (totalVertices > kMaxElements)
+        throw Error(ErrorCode::kUnsupportedMesh, source + ": more than 2^32 - 2 vertices");
+      if (in->mNumVertices > 0 && !in->mVertices) throw Error(ErrorCode::kParseError, where + ": no vertex positions");
+      const std::uint32_t base = mesh.vertexCount();
+      for (unsigned v = 0; v < in->mNumVertices; ++v) {
+        const aiVector3D& p = in->mVertices[v];
+        const Vec3 local(p.x, p.y, p.z);
+        if (!local.allFinite())
+          throw Error(ErrorCode::kNonFiniteVertex, where + ", vertex " + std::to_string(v) + ": non-finite coordinate (" +
+                                                       std::to_string(local.x()) + ", " + std::to_string(local.y()) +
+                                                       ", " + std::to_string(local.z()) + ")");
+        const Vec3 world(m.a1 * local.x() + m.a2 * local.y() + m.a3 * local.z() + m.a4,
+                         m.b1 * local.x() + m.b2 * local.y() + m.b3 * local.z() + m.b4,
+                         m.c1 * local.x() + m.c2 * local.y() + m.c3 * local.z() + m.c4);
+        if (!world.allFinite())
+          throw Error(ErrorCode::kNonFiniteVertex, where + ", vertex " + std::to_string(v) +
+                                                       ": coordinate not finite after the node transform");
+        mesh.vertices.push_back(world);
+      }
+      if (in->mNumFaces > 0 && !in->mFaces) throw Error(ErrorCode::kParseError, where + ": no faces");
+      for (unsigned f = 0; f < in->mNumFaces; ++f) {
+        const aiFace& face = in->mFaces[f];
+        if (face.mNumIndices != 3) {
+          // Points and lines; polygons cannot remain after aiProcess_Triangulate.
+          ++ignoredPrimitives;
+          continue;
+        }
+        Triangle t;
+        for (unsigned c = 0; c < 3; ++c) {
+          const unsigned index = face.mIndices[c];
+          if (index >= in->mNumVertices)
+            throw Error(ErrorCode::kIndexOutOfRange, where + ", face " + std::to_string(f) + ": vertex index " +
+                                                         std::to_string(index) + " >= vertex count " +
+                                                         std::to_string(in->mNumVertices));
+          t[c] = base + index;
+        }
+        if (mirrored) std::swap(t[1], t[2]);
+        if (++totalTriangles > kMaxElements) throw Error(ErrorCode::kUnsupportedMesh, source + ": more than 2^32 - 2 triangles");
+        mesh.triangles.push_back(t);
+      }
+    }
+  }
+
+  result.importedVertexCount = mesh.vertexCount();
+  if (mesh.triangles.empty())
+    throw Error(ErrorCode::kNoTriangles, source + ": no triangles (" + std::to_string(mesh.vertexCount()) + " vertices, " +
+                                             std::to_string(ignoredPrimitives) + " points/lines)");
+
+  const double diagonal = mesh.bounds().diagonal();
+  // Relative tolerances square and cube the diagonal; past ~1e100 that overflows.
+  if (!(diagonal < 1e100))
+    throw Error(ErrorCode::kUnsupportedMesh, source + ": bounding-box diagonal " + std::to_string(diagonal) + " is too large");
+  if (options.weldToleranceRel >= 0.0) {
+    result.weldToleranceAbs = options.weldToleranceRel * diagonal;
+    if (!std::isfinite(result.weldToleranceAbs))
+      throw Error(ErrorCode::kInvalidArgument, "weldToleranceRel " + std::to_string(options.weldToleranceRel) + " is too large");
+    const WeldResult weld = weldVertices(mesh, result.weldToleranceAbs);
+    result.weldedVertexCount = weld.mergedCount;
+  }
+
+  result.report = validateMesh(mesh);
+  try {
+    throwIfUnusable(result.report);
+  } catch (const Error& e) {
+    throw Error(e.code(), source + ": " + e.what());
+  }
+  if (options.orientOutward && result.report.insideOut()) {
+    flipOrientation(mesh);
+    result.flipped = true;
+    result.report = validateMesh(mesh);
+  }
+  result.warnings.reserve(result.warnings.size() + result.report.issues.size() + 2);
+  for (const MeshIssue& issue : result.report.issues) result.warnings.push_back(issue.message);
+  if (result.flipped) result.warnings.push_back("the mesh was inside-out: every triangle was flipped");
+  if (ignoredPrimitives > 0)
+    result.warnings.push_back(std::to_string(ignoredPrimitives) + " points/lines in the file were ignored");
+  return result;
+}
+
+void checkOptions(const MeshLoadOptions& options) {
+  if (std::isnan(options.weldToleranceRel)) throw Error(ErrorCode::kInvalidArgument, "weldToleranceRel is NaN");
+}
+
+}  // namespace
+
+LoadedMesh loadMesh(const std::filesystem::path& path, const MeshLoadOptions& options) {
+  checkOptions(options);
+  const std::string source = std::string("'").append(path.string()).append("'");
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) throw Error(ErrorCode::kFileNotFound, source + " does not exist");
+  if (std::filesystem::is_directory(status)) throw Error(ErrorCode::kFileUnreadable, source + " is a directory");
+  if (!std::filesystem::is_regular_file(status)) throw Error(ErrorCode::kFileUnreadable, source + " is not a regular file");
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) throw Error(ErrorCode::kFileUnreadable, source + ": " + ec.message());
+  if (size == 0) throw Error(ErrorCode::kEmptyFile, source + " is empty (0 bytes)");
+  {
+    // Assimp's own "cannot open" message does not tell permissions from format trouble.
+    std::FILE* probe = std::fopen(path.c_str(), "rb");
+    if (!probe) throw Error(ErrorCode::kFileUnreadable, "cannot open " + source + " for reading");
+    std::fclose(probe);
+  }
+  std::string format = lowercase(path.extension().string());
+  if (!format.empty()) format.erase(0, 1);
+  // The text of OBJ and OFF files is needed for the index checks (see text_index_check.h).
+  std::string text;
+  if (format == "obj" || format == "off") text = readWholeFile(path);
+  if (format == "off")
+    if (auto bad = detail::findBadOffIndex(text)) throw Error(ErrorCode::kIndexOutOfRange, source + ": " + *bad);
+
+  Assimp::Importer importer;
+  CapturedLog log;
+  // Through ReadFile, not from memory, so that a .gltf finds its external .bin next to it.
+  const aiScene* scene = importCapturingLog(importer, log, [&](Assimp::Importer& imp) {
+    return imp.ReadFile(path.string(), kImportFlags);
+  });
+  if (!scene) throwImportError(source, importer.GetErrorString(), format, text);
+  return convertScene(scene, log, source, options);
+}
+
+LoadedMesh loadMeshFromMemory(std::span<const std::byte> bytes, std::string_view formatHint,
+                              const MeshLoadOptions& options) {
+  checkOptions(options);
+  if (formatHint.empty() || formatHint.size() > 15)
+    throw Error(ErrorCode::kInvalidArgument, "format hint '" + std::string(formatHint) + "' must be 1 to 15 characters");
+  for (char c : formatHint)
+    if (!std::isalnum(static_cast<unsigned char>(c)))
+      throw Error(ErrorCode::kInvalidArgument, "format hint '" + std::string(formatHint) + "' must be letters and digits");
+  const std::string format = lowercase(std::string(formatHint));
+  const std::string source = "<memory:" + format + ">";
+  if (bytes.empty()) throw Error(ErrorCode::kEmptyFile, source + " is empty (0 bytes)");
+  const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  if (format == "off")
+    if (auto bad = detail::findBadOffIndex(text)) throw Error(ErrorCode::kIndexOutOfRange, source + ": " + *bad);
+
+  Assimp::Importer importer;
+  CapturedLog log;
+  const aiScene* scene = importCapturingLog(importer, log, [&](Assimp::Importer& imp) {
+    return imp.ReadFileFromMemory(bytes.data(), bytes.size(), kImportFlags, format.c_str());
+  });
+  if (!scene) throwImportError(source, importer.GetErrorString(), format, text);
+  return convertScene(scene, log, source, options);
+}
+
+}  // namespace clod

@@ -1,0 +1,126 @@
+#include "text_index_check.h"
+
+#include <charconv>
+#include <vector>
+
+namespace clod::detail {
+
+namespace {
+
+// Splits into lines (LF or CRLF), dropping '#' comments; calls f(lineNumber, tokens) for
+// every line with at least one token. Returning false from f stops the scan.
+template <class F>
+void forEachTokenLine(std::string_view text, F&& f) {
+  std::vector<std::string_view> tokens;
+  std::size_t lineNumber = 0;
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    std::size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(pos, end - pos);
+    pos = end + 1;
+    ++lineNumber;
+    if (auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+    tokens.clear();
+    std::size_t i = 0;
+    while (i < line.size()) {
+      while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
+      std::size_t j = i;
+      while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r') ++j;
+      if (j > i) tokens.push_back(line.substr(i, j - i));
+      i = j;
+    }
+    if (!tokens.empty() && !f(lineNumber, tokens)) return;
+  }
+}
+
+std::optional<long long> parseInteger(std::string_view token) {
+  long long value = 0;
+  auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+  if (ec != std::errc() || ptr != token.data() + token.size()) return std::nullopt;
+  return value;
+}
+
+}  // namespace
+
+std::optional<std::string> findBadOffIndex(std::string_view text) {
+  enum class Stage { kHeader, kCounts, kVertices, kFaces, kDone } stage = Stage::kHeader;
+  long long vertexCount = 0, faceCount = 0, verticesSeen = 0, facesSeen = 0;
+  std::optional<std::string> result;
+  forEachTokenLine(text, [&](std::size_t line, const std::vector<std::string_view>& tokens) {
+    std::size_t first = 0;
+    if (stage == Stage::kHeader) {
+      std::string_view keyword = tokens[0];
+      // Accept the optional ST, C, N prefixes in that order; 4OFF / nOFF change the layout.
+      if (keyword.starts_with("ST")) keyword.remove_prefix(2);
+      if (keyword.starts_with("C")) keyword.remove_prefix(1);
+      if (keyword.starts_with("N")) keyword.remove_prefix(1);
+      if (keyword != "OFF") {
+        stage = Stage::kDone;
+        return false;
+      }
+      stage = Stage::kCounts;
+      if (tokens.size() == 1) return true;
+      first = 1;  // counts on the header line
+    }
+    if (stage == Stage::kCounts) {
+      if (tokens.size() < first + 2) return false;
+      auto v = parseInteger(tokens[first]);
+      auto f = parseInteger(tokens[first + 1]);
+      if (!v || !f || *v < 0 || *f < 0) return false;
+      vertexCount = *v;
+      faceCount = *f;
+      stage = vertexCount > 0 ? Stage::kVertices : Stage::kFaces;
+      return faceCount > 0;
+    }
+    if (stage == Stage::kVertices) {
+      if (++verticesSeen == vertexCount) stage = Stage::kFaces;
+      return true;
+    }
+    // Stage::kFaces
+    auto n = parseInteger(tokens[0]);
+    if (!n || *n < 0 || tokens.size() < std::size_t(*n) + 1) return false;
+    for (long long k = 1; k <= *n; ++k) {
+      auto index = parseInteger(tokens[std::size_t(k)]);
+      if (!index) return false;
+      if (*index < 0 || *index >= vertexCount) {
+        result = "line " + std::to_string(line) + ": face " + std::to_string(facesSeen) + ": vertex index " +
+                 std::to_string(*index) + (*index < 0 ? " is negative" : " >= vertex count " + std::to_string(vertexCount));
+        return false;
+      }
+    }
+    return ++facesSeen < faceCount;
+  });
+  return result;
+}
+
+std::optional<std::string> findBadObjIndex(std::string_view text) {
+  long long totalVertices = 0;
+  forEachTokenLine(text, [&](std::size_t, const std::vector<std::string_view>& tokens) {
+    if (tokens[0] == "v") ++totalVertices;
+    return true;
+  });
+  long long verticesSoFar = 0;
+  std::optional<std::string> result;
+  forEachTokenLine(text, [&](std::size_t line, const std::vector<std::string_view>& tokens) {
+    if (tokens[0] == "v") ++verticesSoFar;
+    if (tokens[0] != "f" && tokens[0] != "l" && tokens[0] != "p") return true;
+    for (std::size_t k = 1; k < tokens.size(); ++k) {
+      std::string_view corner = tokens[k].substr(0, tokens[k].find('/'));  // v/vt/vn: the position index
+      auto index = parseInteger(corner);
+      if (!index) continue;
+      // OBJ indices are 1-based; negative ones count back from the latest vertex.
+      const long long resolved = *index > 0 ? *index : verticesSoFar + *index + 1;
+      if (*index == 0 || resolved < 1 || resolved > totalVertices) {
+        result = "line " + std::to_string(line) + ": vertex index " + std::string(corner) +
+                 (*index > 0 ? " > vertex count " + std::to_string(totalVertices)
+                             : " does not refer to a vertex (" + std::to_string(verticesSoFar) + " defined so far)");
+        return false;
+      }
+    }
+    return true;
+  });
+  return result;
+}
+
+}  // namespace clod::detail

@@ -1,0 +1,241 @@
+#include "clod/mesh_io.h"
+
+#include <cstring>
+#include <fstream>
+#include <set>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "clod/error.h"
+#include "mesh_test_support.h"
+
+namespace clod {
+namespace {
+
+using test::badFile;
+using test::goodFile;
+
+std::string readBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::span<const std::byte> asBytes(const std::string& text) {
+  return {reinterpret_cast<const std::byte*>(text.data()), text.size()};
+}
+
+struct Thrown {
+  ErrorCode code;
+  std::string message;
+};
+
+template <class F>
+Thrown thrownBy(F&& load) {
+  try {
+    load();
+  } catch (const Error& e) {
+    return {e.code(), e.what()};
+  }
+  ADD_FAILURE() << "no clod::Error thrown";
+  return {ErrorCode::kInvalidArgument, ""};
+}
+
+// Every good file holds the box [0,1] x [0,2] x [0,3] (unequal sides catch swapped axes), stored
+// as quads (OBJ, PLY, OFF), triangle soup (STL) or indexed triangles with a node transform
+// (glTF/GLB: positions shifted by -5 in x, the node translates by +5).
+void expectTheBox(const LoadedMesh& loaded, const std::string& name) {
+  SCOPED_TRACE(name);
+  const MeshReport& r = loaded.report;
+  EXPECT_EQ(loaded.mesh.vertexCount(), 8u);
+  EXPECT_EQ(loaded.mesh.triangleCount(), 12u);
+  EXPECT_TRUE(r.closed);
+  EXPECT_TRUE(r.consistentlyOriented);
+  EXPECT_EQ(r.components, 1u);
+  EXPECT_EQ(r.degenerateTriangles, 0u);
+  ASSERT_TRUE(r.signedVolume.has_value());
+  // Corners are small integers, exact in float and double: the volume 1*2*3 is exact.
+  EXPECT_EQ(*r.signedVolume, 6.0);
+  EXPECT_EQ(r.bounds.min, Vec3(0, 0, 0));
+  EXPECT_EQ(r.bounds.max, Vec3(1, 2, 3));
+  std::set<std::tuple<double, double, double>> corners;
+  for (const Vec3& v : loaded.mesh.vertices) corners.insert({v.x(), v.y(), v.z()});
+  std::set<std::tuple<double, double, double>> expected;
+  for (double x : {0.0, 1.0})
+    for (double y : {0.0, 2.0})
+      for (double z : {0.0, 3.0}) expected.insert({x, y, z});
+  EXPECT_EQ(corners, expected);
+  EXPECT_FALSE(loaded.flipped);
+  EXPECT_TRUE(loaded.warnings.empty()) << loaded.warnings.front();
+}
+
+TEST(LoadMesh, EveryFormatLoadsTheSameBox) {
+  for (const char* name : {"box.obj", "box_ascii.stl", "box_binary.stl", "box.ply", "box.off", "box.gltf", "box.glb"})
+    expectTheBox(loadMesh(goodFile(name)), name);
+}
+
+TEST(LoadMesh, EveryFormatLoadsTheSameBoxFromMemory) {
+  for (const char* name : {"box.obj", "box_ascii.stl", "box_binary.stl", "box.ply", "box.off", "box.gltf", "box.glb"}) {
+    const std::string bytes = readBytes(goodFile(name));
+    std::string hint = name;
+    hint = hint.substr(hint.rfind('.') + 1);
+    expectTheBox(loadMeshFromMemory(asBytes(bytes), hint), name);
+  }
+}
+
+TEST(LoadMesh, StlTriangleSoupIsWeldedUnlessWeldingIsDisabled) {
+  const LoadedMesh welded = loadMesh(goodFile("box_binary.stl"));
+  EXPECT_EQ(welded.importedVertexCount, 36u);
+  EXPECT_EQ(welded.weldedVertexCount, 28u);
+  MeshLoadOptions noWeld;
+  noWeld.weldToleranceRel = -1.0;
+  const LoadedMesh soup = loadMesh(goodFile("box_binary.stl"), noWeld);
+  EXPECT_EQ(soup.mesh.vertexCount(), 36u);
+  EXPECT_EQ(soup.report.boundaryEdges, 36u);  // 12 separate triangles
+  EXPECT_EQ(soup.report.components, 12u);
+}
+
+TEST(LoadMesh, WeldToleranceIsRelativeToTheDiagonal) {
+  // Two triangles sharing an edge whose copies differ by 2^-20 (exact in float, which Assimp
+  // stores), in a mesh of diagonal ~141: merged at the default 1e-7 * diagonal = 1.4e-5, kept
+  // apart when only exact duplicates merge.
+  const std::string obj =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1.00000095367431640625 0 0\nv 0 1.00000095367431640625 0\nv 100 100 0\n"
+      "f 1 2 3\nf 4 6 5\n";
+  const LoadedMesh welded = loadMeshFromMemory(asBytes(obj), "obj");
+  EXPECT_EQ(welded.mesh.vertexCount(), 4u);
+  EXPECT_EQ(welded.report.boundaryEdges, 4u);
+  EXPECT_EQ(welded.report.components, 1u);
+  MeshLoadOptions exact;
+  exact.weldToleranceRel = 0.0;
+  const LoadedMesh apart = loadMeshFromMemory(asBytes(obj), "obj", exact);
+  EXPECT_EQ(apart.mesh.vertexCount(), 6u);
+  EXPECT_EQ(apart.report.boundaryEdges, 6u);
+  EXPECT_EQ(apart.report.components, 2u);
+}
+
+TEST(LoadMesh, InsideOutBoxIsFlippedWithAWarning) {
+  const LoadedMesh loaded = loadMesh(goodFile("box_inside_out.obj"));
+  EXPECT_TRUE(loaded.flipped);
+  ASSERT_TRUE(loaded.report.signedVolume.has_value());
+  EXPECT_EQ(*loaded.report.signedVolume, 6.0);
+  bool warned = false;
+  for (const std::string& w : loaded.warnings) warned |= w.find("inside-out") != std::string::npos;
+  EXPECT_TRUE(warned);
+
+  MeshLoadOptions keep;
+  keep.orientOutward = false;
+  const LoadedMesh kept = loadMesh(goodFile("box_inside_out.obj"), keep);
+  EXPECT_FALSE(kept.flipped);
+  EXPECT_EQ(*kept.report.signedVolume, -6.0);
+}
+
+// glTF node transforms: a mirroring scale must not turn the box inside-out, and a mesh used by
+// two nodes appears twice.
+TEST(LoadMesh, GltfNodeTransformsAreAppliedAndMirroringKeepsOutward) {
+  nlohmann::json gltf = nlohmann::json::parse(readBytes(goodFile("box.gltf")));
+  gltf["nodes"][0]["scale"] = {-1, 1, 1};  // x -> -x + 5: the box lands on [9, 10] in x
+  const std::string mirrored = gltf.dump();
+  const LoadedMesh loaded = loadMeshFromMemory(asBytes(mirrored), "gltf");
+  EXPECT_EQ(loaded.report.bounds.min, Vec3(9, 0, 0));
+  EXPECT_EQ(loaded.report.bounds.max, Vec3(10, 2, 3));
+  EXPECT_FALSE(loaded.flipped);
+  ASSERT_TRUE(loaded.report.signedVolume.has_value());
+  EXPECT_EQ(*loaded.report.signedVolume, 6.0);
+
+  gltf["nodes"][0].erase("scale");
+  gltf["nodes"].push_back({{"mesh", 0}, {"translation", {20, 0, 0}}});
+  gltf["scenes"][0]["nodes"] = {0, 1};
+  const std::string twice = gltf.dump();
+  const LoadedMesh two = loadMeshFromMemory(asBytes(twice), "gltf");
+  EXPECT_EQ(two.mesh.triangleCount(), 24u);
+  EXPECT_EQ(two.report.components, 2u);
+  EXPECT_EQ(two.report.bounds.max, Vec3(16, 2, 3));  // [-5,-4] + 20
+  EXPECT_EQ(*two.report.signedVolume, 12.0);
+}
+
+TEST(LoadMesh, PointsAndLinesAreIgnoredWithAWarning) {
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 5 5\nf 1 2 3\nl 1 4\n";
+  const LoadedMesh loaded = loadMeshFromMemory(asBytes(obj), "obj");
+  EXPECT_EQ(loaded.mesh.triangleCount(), 1u);
+  bool warned = false;
+  for (const std::string& w : loaded.warnings) warned |= w.find("points/lines") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
+struct BadCase {
+  const char* file;
+  ErrorCode code;
+  const char* culprit;  // must appear in the message
+};
+
+TEST(LoadMesh, EveryBadFileGivesItsErrorCodeAndNamesTheCulprit) {
+  const BadCase cases[] = {
+      {"empty.obj", ErrorCode::kEmptyFile, "0 bytes"},
+      {"garbage.xyz", ErrorCode::kUnknownFormat, "unknown file format"},
+      {"nan_vertex.obj", ErrorCode::kNonFiniteVertex, "nan"},
+      {"inf_vertex.off", ErrorCode::kNonFiniteVertex, "inf"},
+      {"index_out_of_range.obj", ErrorCode::kIndexOutOfRange, "line 5: vertex index 9001"},
+      {"index_out_of_range.off", ErrorCode::kIndexOutOfRange, "line 7: face 1: vertex index 9001 >= vertex count 3"},
+      {"negative_index.off", ErrorCode::kIndexOutOfRange, "vertex index -1 is negative"},
+      {"index_out_of_range.ply", ErrorCode::kIndexOutOfRange, "face 1: vertex index 9001 >= vertex count 3"},
+      {"index_out_of_range.gltf", ErrorCode::kIndexOutOfRange, "out-of-range"},
+      {"no_triangles.obj", ErrorCode::kNoTriangles, "no triangles"},
+      {"all_degenerate.obj", ErrorCode::kAllTrianglesDegenerate, "all 3 triangles have zero area"},
+      {"truncated_binary.stl", ErrorCode::kParseError, "STL"},
+      {"malformed.off", ErrorCode::kParseError, "zero"},
+  };
+  for (const BadCase& c : cases) {
+    SCOPED_TRACE(c.file);
+    const Thrown thrown = thrownBy([&] { loadMesh(badFile(c.file)); });
+    EXPECT_EQ(thrown.code, c.code) << errorCodeName(thrown.code) << ": " << thrown.message;
+    EXPECT_NE(thrown.message.find(c.file), std::string::npos) << thrown.message;
+    EXPECT_NE(thrown.message.find(c.culprit), std::string::npos) << thrown.message;
+  }
+}
+
+TEST(LoadMesh, MissingFileAndDirectoryAreRejected) {
+  Thrown missing = thrownBy([] { loadMesh(badFile("does_not_exist.obj")); });
+  EXPECT_EQ(missing.code, ErrorCode::kFileNotFound);
+  EXPECT_NE(missing.message.find("does_not_exist.obj"), std::string::npos);
+  Thrown directory = thrownBy([] { loadMesh(std::string(CLOD_TEST_DATA_DIR) + "/bad"); });
+  EXPECT_EQ(directory.code, ErrorCode::kFileUnreadable);
+  EXPECT_NE(directory.message.find("directory"), std::string::npos);
+}
+
+TEST(LoadMeshFromMemory, RejectsEmptyBytesAndBadHints) {
+  EXPECT_EQ(thrownBy([] { loadMeshFromMemory({}, "obj"); }).code, ErrorCode::kEmptyFile);
+  const std::string obj = readBytes(goodFile("box.obj"));
+  EXPECT_EQ(thrownBy([&] { loadMeshFromMemory(asBytes(obj), ""); }).code, ErrorCode::kInvalidArgument);
+  EXPECT_EQ(thrownBy([&] { loadMeshFromMemory(asBytes(obj), "../obj"); }).code, ErrorCode::kInvalidArgument);
+  EXPECT_EQ(thrownBy([&] { loadMeshFromMemory(asBytes(obj), "averyveryverylongextension"); }).code,
+            ErrorCode::kInvalidArgument);
+  MeshLoadOptions nanOptions;
+  nanOptions.weldToleranceRel = std::nan("");
+  EXPECT_EQ(thrownBy([&] { loadMeshFromMemory(asBytes(obj), "obj", nanOptions); }).code, ErrorCode::kInvalidArgument);
+}
+
+TEST(LoadMeshFromMemory, BinaryStlWithNanCoordinateIsRejected) {
+  std::string stl = readBytes(goodFile("box_binary.stl"));
+  ASSERT_EQ(stl.size(), 84u + 12u * 50u);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::memcpy(stl.data() + 84 + 5 * 50 + 12 + 4, &nan, sizeof nan);  // triangle 5, first corner, y
+  const Thrown thrown = thrownBy([&] { loadMeshFromMemory(asBytes(stl), "stl"); });
+  EXPECT_EQ(thrown.code, ErrorCode::kNonFiniteVertex);
+  EXPECT_NE(thrown.message.find("nan"), std::string::npos) << thrown.message;
+}
+
+TEST(LoadMesh, ConcurrentLoadsAllSucceed) {
+  std::vector<std::thread> threads;
+  std::vector<int> ok(4, 0);
+  for (int i = 0; i < 4; ++i)
+    threads.emplace_back([&, i] {
+      for (int k = 0; k < 5; ++k) ok[i] += loadMesh(goodFile(i % 2 ? "box.glb" : "box.obj")).mesh.triangleCount() == 12;
+    });
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(ok, (std::vector<int>{5, 5, 5, 5}));
+}
+
+}  // namespace
+}  // namespace clod

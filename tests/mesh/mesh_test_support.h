@@ -1,0 +1,62 @@
+#pragma once
+// Helpers shared by the mesh layer's tests: brute-force oracles written independently of
+// src/mesh (maps and sets, quadratic loops), and paths to the test data.
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "clod/mesh.h"
+
+namespace clod::test {
+
+inline std::string goodFile(const std::string& name) { return std::string(CLOD_TEST_DATA_DIR) + "/good/" + name; }
+inline std::string badFile(const std::string& name) { return std::string(CLOD_TEST_DATA_DIR) + "/bad/" + name; }
+inline std::string sharedMesh(const std::string& name) { return std::string(CLOD_SHARED_MESH_DIR) + "/" + name; }
+
+/// True in the sanitizer CI run, where sample counts may be reduced.
+inline bool sanitizerRun() {
+  const char* scale = std::getenv("CLOD_TEST_SCALE");
+  return scale && std::strcmp(scale, "sanitizer") == 0;
+}
+
+/// Brute-force edge use counts: undirected edge (min, max) -> number of triangle sides on it.
+inline std::map<std::pair<std::uint32_t, std::uint32_t>, int> countEdgeUses(const TriangleMesh& mesh) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+  for (const Triangle& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t a = t[k], b = t[(k + 1) % 3];
+      ++uses[{std::min(a, b), std::max(a, b)}];
+    }
+  return uses;
+}
+
+/// Brute-force connected components of the vertices used by triangles (flood fill).
+inline std::uint32_t countComponentsByFloodFill(const TriangleMesh& mesh) {
+  std::map<std::uint32_t, std::set<std::uint32_t>> neighbours;
+  for (const Triangle& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < 3; ++j) neighbours[t[k]].insert(t[j]);
+  std::set<std::uint32_t> seen;
+  std::uint32_t components = 0;
+  for (const auto& [start, unused] : neighbours) {
+    if (seen.count(start)) continue;
+    ++components;
+    std::vector<std::uint32_t> stack{start};
+    seen.insert(start);
+    while (!stack.empty()) {
+      std::uint32_t v = stack.back();
+      stack.pop_back();
+      for (std::uint32_t w : neighbours[v])
+        if (seen.insert(w).second) stack.push_back(w);
+    }
+  }
+  return components;
+}
+
+}  // namespace clod::test
