@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <span>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -41,6 +42,8 @@ public:
     const auto* bytes = reinterpret_cast<const std::byte*>(text.data());
     buffer_.insert(buffer_.end(), bytes, bytes + text.size());
   }
+  /// Appends raw bytes as they are (no count prefix).
+  void writeBytes(std::span<const std::byte> bytes) { buffer_.insert(buffer_.end(), bytes.begin(), bytes.end()); }
   /// Pads with zero bytes to a multiple of `alignment`.
   void align(std::size_t alignment) {
     while (buffer_.size() % alignment != 0) buffer_.push_back(std::byte{0});
@@ -91,6 +94,13 @@ public:
     std::string text(reinterpret_cast<const char*>(data_ + offset_), count);
     offset_ += count;
     return text;
+  }
+  /// Consumes `count` raw bytes and returns a view of them (valid as long as the buffer is).
+  std::span<const std::byte> readBytes(std::uint64_t count) {
+    require(count);
+    std::span<const std::byte> view(data_ + offset_, static_cast<std::size_t>(count));
+    offset_ += static_cast<std::size_t>(count);
+    return view;
   }
   void skipAlignment(std::size_t alignment) {
     const std::size_t pad = (alignment - offset_ % alignment) % alignment;

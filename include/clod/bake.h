@@ -1,0 +1,131 @@
+#pragma once
+// Bake files (.clod): everything clod precomputes for one mesh, in one checked binary file,
+// so an engine loads assets instead of rebuilding them. Today a bake holds the mesh and its
+// sphere-tree; later versions add closest feature maps and the contact tree as further
+// sections (older readers skip sections they do not know).
+//
+// Typical use:
+//   BakeResult baked = bakeMesh(loadMesh("bunny.obj").mesh, settings);   // minutes at most
+//   saveBake("bunny.clod", baked.contents);                               // atomic
+//   BakeContents contents = loadBake("bunny.clod");                       // milliseconds
+//
+// Byte layout: docs/bake-format.md; the container (header, section table, checksums) is in
+// bake_file.h. Every function that reads bytes treats them as untrusted: a truncated,
+// corrupted or newer file throws clod::Error and never crashes or returns wrong content.
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "clod/bake_file.h"
+#include "clod/error.h"
+#include "clod/mesh.h"
+#include "clod/proximity.h"
+#include "clod/sphere_tree.h"
+#include "clod/sphere_tree_builder.h"
+
+namespace clod {
+
+/// Section tags and the newest version of each that this build writes and reads.
+inline constexpr BakeSectionTag kBakeMeshTag = makeBakeSectionTag("MESH");
+inline constexpr std::uint32_t kBakeMeshVersion = 1;
+inline constexpr BakeSectionTag kBakeSphereTreeTag = makeBakeSectionTag("STRE");
+inline constexpr std::uint32_t kBakeSphereTreeVersion = 1;
+
+/// 64-bit content hash of a mesh, for cache keys and to tie a bake to its mesh: XXH3-64
+/// (seed 0) over the vertex count and triangle count (u64 each), then every vertex coordinate
+/// (f64, x y z per vertex), then every triangle index (u32, three per triangle), all
+/// little-endian. Any change of a coordinate bit or an index changes it (with overwhelming
+/// probability); -0.0 and +0.0 hash differently. O(V + T), a few GB/s.
+std::uint64_t meshContentHash(const TriangleMesh& mesh) noexcept;
+
+/// Everything a bake file holds. Plain data; equal contents encode to identical bytes.
+/// Sections added by later issues become further members (optional ones may be absent).
+struct BakeContents {
+  /// The mesh the rest was built from, in its own coordinates. Required ('MESH').
+  TriangleMesh mesh;
+  /// meshContentHash(mesh). Set by decodeBake/loadBake and bakeMesh; encodeBake ignores this
+  /// field and always stores the hash of `mesh`, so a stale value can never reach a file.
+  std::uint64_t meshHash = 0;
+  /// Where the mesh came from (e.g. its file name), for humans; may be empty. ('MESH')
+  std::string sourceName;
+
+  /// The sphere-tree and the settings it was built with. Required ('STRE').
+  SphereTree sphereTree;
+  SphereTreeSettings sphereTreeSettings;
+};
+
+/// Encodes contents as a complete bake file. Deterministic: equal contents give identical
+/// bytes, and encodeBake(decodeBake(bytes)) == bytes for every file this function wrote.
+/// O(size of the contents).
+///
+/// Checks first that the contents can be decoded again and throws
+/// clod::Error(kInvalidArgument) naming the field otherwise (non-finite coordinates, triangle
+/// indices >= vertex count, an inconsistent sphere-tree: see decodeBake for the list, or
+/// more than 2^32-1 of anything), so no file that loadBake would reject is ever written.
+std::vector<std::byte> encodeBake(const BakeContents& contents);
+
+/// Decodes a bake file held in memory. Besides the container checks (bake_file.h), checks
+/// every semantic invariant before returning, and throws clod::Error(kBakeCorrupt) naming the
+/// section and field when one fails: mesh coordinates finite, triangle indices < vertex
+/// count, stored mesh hash == meshContentHash of the decoded mesh; sphere-tree arrays sized
+/// consistently with the sphere count, levelOffsets starting at 0 with one root sphere and
+/// strictly increasing to the sphere count, centres finite, radii finite and >= 0, parent and
+/// child ranges pointing into the neighbouring levels and agreeing with each other,
+/// triangleOffsets monotone from 0 to the triangle list size, triangle indices < the mesh's
+/// triangle count, a known method. Other errors: kBakeTruncated, kBakeVersion (the file or a
+/// known section is newer than this build), kBakeMissingSection ('MESH' or 'STRE' absent).
+/// Sections with unknown tags are skipped. O(file size).
+BakeContents decodeBake(std::span<const std::byte> bytes);
+
+/// Writes a bake file atomically (temporary file in the same directory, then rename): a crash
+/// or failure never leaves a partial file at `path`, and an existing file there stays intact
+/// on failure. Returns the number of bytes written. Throws clod::Error: kInvalidArgument (as
+/// encodeBake), kFileWriteFailed naming the path.
+std::size_t saveBake(const std::filesystem::path& path, const BakeContents& contents);
+
+/// Reads a bake file with a single read() of the whole file, then decodes it (decodeBake).
+/// Throws clod::Error: kFileNotFound, kFileUnreadable, kEmptyFile (zero bytes), and every
+/// error of decodeBake; messages start with the path.
+BakeContents loadBake(const std::filesystem::path& path);
+
+/// What bakeMesh builds and how.
+struct BakeSettings {
+  SphereTreeSettings sphereTree;
+  MeshDistanceSettings distance;
+  /// Measure the fit of every sphere-tree level (measureSphereTreeFit) for the report.
+  bool measureFit = true;
+  /// Stored in BakeContents::sourceName.
+  std::string sourceName;
+};
+
+/// Wall-clock seconds per stage of bakeMesh.
+struct BakeTimings {
+  double distanceSeconds = 0.0;    ///< building MeshDistance (BVH, topology, pseudonormals)
+  double sphereTreeSeconds = 0.0;  ///< buildSphereTree
+  double fitSeconds = 0.0;         ///< measureSphereTreeFit (0 if not measured)
+  /// Everything that goes into the file: distanceSeconds + sphereTreeSeconds (+ later sections);
+  /// excludes fit measurement.
+  double buildSeconds = 0.0;
+};
+
+/// The result of bakeMesh: the contents to save plus a report on how they were built.
+struct BakeResult {
+  BakeContents contents;
+  /// Fit per sphere-tree level, root first (empty unless BakeSettings::measureFit).
+  std::vector<SphereTreeLevelFit> levelFit;
+  /// How MeshDistance decided inside/outside for this mesh.
+  SignMethod signMethod = SignMethod::kPseudonormal;
+  BakeTimings timings;
+};
+
+/// Builds everything a bake holds for `mesh`: MeshDistance, then the sphere-tree (and later
+/// sections). The mesh must be valid (see MeshDistance). Throws clod::Error from the
+/// builders: kInvalidArgument for out-of-range settings, mesh errors for invalid meshes.
+/// Uses TBB inside the builders.
+BakeResult bakeMesh(const TriangleMesh& mesh, const BakeSettings& settings);
+
+}  // namespace clod

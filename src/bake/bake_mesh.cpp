@@ -1,0 +1,37 @@
+#include <chrono>
+
+#include "clod/bake.h"
+
+namespace clod {
+
+namespace {
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+}  // namespace
+
+BakeResult bakeMesh(const TriangleMesh& mesh, const BakeSettings& settings) {
+  BakeResult result;
+  auto start = std::chrono::steady_clock::now();
+  const MeshDistance distance(mesh, settings.distance);
+  result.timings.distanceSeconds = secondsSince(start);
+  result.signMethod = distance.signMethod();
+
+  start = std::chrono::steady_clock::now();
+  result.contents.sphereTree = buildSphereTree(distance, settings.sphereTree);
+  result.timings.sphereTreeSeconds = secondsSince(start);
+  result.timings.buildSeconds = result.timings.distanceSeconds + result.timings.sphereTreeSeconds;
+
+  if (settings.measureFit) {
+    start = std::chrono::steady_clock::now();
+    result.levelFit = measureSphereTreeFit(result.contents.sphereTree, distance);
+    result.timings.fitSeconds = secondsSince(start);
+  }
+  result.contents.mesh = mesh;
+  result.contents.meshHash = meshContentHash(mesh);
+  result.contents.sourceName = settings.sourceName;
+  result.contents.sphereTreeSettings = settings.sphereTree;
+  return result;
+}
+
+}  // namespace clod
