@@ -121,7 +121,7 @@ std::vector<std::byte> encodeSphereTreeSection(const SphereTree& tree, const Sph
   writer.write<std::uint16_t>(0);
   writer.write<std::uint32_t>(settings.branching);
   writer.write<std::uint32_t>(settings.depth);
-  writer.write<std::uint32_t>(0);
+  writer.write<std::uint32_t>(settings.medialSamples);
   forEachSphereArray(tree, [&](const char*, const auto& values) { writeAlignedArray(writer, values); });
   return writer.take();
 }
@@ -133,7 +133,7 @@ DecodedSphereTreeSection decodeSphereTreeSection(std::span<const std::byte> payl
   if (reader.read<std::uint8_t>() != 0 || reader.read<std::uint16_t>() != 0) reader.fail("reserved bytes after the method are not 0");
   decoded.settings.branching = reader.read<std::uint32_t>();
   decoded.settings.depth = reader.read<std::uint32_t>();
-  if (reader.read<std::uint32_t>() != 0) reader.fail("reserved field after depth is not 0");
+  decoded.settings.medialSamples = reader.read<std::uint32_t>();
   forEachSphereArray(decoded.tree, [&](const char*, auto& values) {
     values = readAlignedArray<typename std::decay_t<decltype(values)>::value_type>(reader);
   });

@@ -36,7 +36,7 @@ TEST(BakeRoundTrip, SpecialValuesSurviveBitExactly) {
   contents.mesh.vertices[2].z() = 1.7976931348623157e308;
   contents.sphereTree.radius.back() = 0.0;
   contents.sourceName = std::string("n\0l\xff", 4);  // arbitrary bytes, not just text
-  contents.sphereTreeSettings = {SphereTreeMethod::kMedial, 3, 9};
+  contents.sphereTreeSettings = {SphereTreeMethod::kMedial, 3, 9, 4321};
   const BakeContents decoded = decodeBake(encodeBake(contents));
   contents.meshHash = meshContentHash(contents.mesh);
   expectSameContents(contents, decoded);

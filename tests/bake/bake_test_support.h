@@ -101,6 +101,7 @@ inline void expectSameContents(const BakeContents& a, const BakeContents& b) {
   EXPECT_EQ(a.sphereTreeSettings.method, b.sphereTreeSettings.method);
   EXPECT_EQ(a.sphereTreeSettings.branching, b.sphereTreeSettings.branching);
   EXPECT_EQ(a.sphereTreeSettings.depth, b.sphereTreeSettings.depth);
+  EXPECT_EQ(a.sphereTreeSettings.medialSamples, b.sphereTreeSettings.medialSamples);
   const SphereTree& s = a.sphereTree;
   const SphereTree& t = b.sphereTree;
   EXPECT_EQ(s.centerX, t.centerX);
