@@ -70,6 +70,13 @@ struct MeshDistanceSettings {
   std::uint32_t leafSize = 4;
   /// Force a sign method; by default pseudonormals for closed meshes, winding numbers otherwise.
   bool forceWindingNumber = false;
+  /// Accuracy of the hierarchical winding number (Barill et al. 2018): a cluster of triangles
+  /// is replaced by its second-order far-field expansion when the query point is farther than
+  /// windingBeta times the cluster's radius from its centre. The truncation error of a cluster
+  /// falls as windingBeta^-3; at the default 2 the total error stays well below the 1/2 that
+  /// would flip an inside/outside decision (tests: < 0.1 on the shared mesh corpus), larger
+  /// values cost more time. Must be finite and >= 1 (kInvalidArgument otherwise).
+  double windingBeta = 2.0;
 };
 
 /// Exact distance queries on one mesh. Build once (O(T log T)), then query from any number
