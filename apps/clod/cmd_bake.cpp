@@ -1,0 +1,141 @@
+// clod bake MESH -o OUT.clod [--sphere-tree octree|medial] [--branching B] [--levels L] [--json]:
+// build everything a bake file holds for a mesh and write it atomically.
+//
+// The JSON keys are a stable contract (external checks use them): levels (one entry per
+// sphere-tree level, root first, each with spheres, fit_mean, fit_max in units of the
+// bounding-box diagonal), build_seconds, file_bytes; plus extras (mesh_hash, vertices,
+// triangles, sign_method, method, branching, depth, per-stage seconds, sections, warnings).
+// Nothing is printed until the file is written, so an error leaves stdout empty, and a failed
+// bake leaves neither OUT.clod nor a temporary file behind.
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "cli_util.h"
+#include "clod/atomic_file.h"
+#include "clod/bake.h"
+#include "clod/error.h"
+#include "clod/mesh_io.h"
+#include "command.h"
+
+namespace clod::cli {
+namespace {
+
+struct BakeOptions {
+  std::string meshPath;
+  std::string outputPath;
+  std::string method = sphereTreeMethodName(SphereTreeSettings{}.method);
+  std::uint32_t branching = SphereTreeSettings{}.branching;
+  std::uint32_t levels = SphereTreeSettings{}.depth;
+  std::uint32_t medialSamples = SphereTreeSettings{}.medialSamples;
+  bool json = false;
+};
+
+std::string hex64(std::uint64_t value) {
+  char text[24];
+  std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(value));
+  return text;
+}
+
+int runBake(const BakeOptions& options) {
+  BakeSettings settings;
+  settings.sphereTree.method = parseSphereTreeMethod(options.method);
+  settings.sphereTree.branching = options.branching;
+  settings.sphereTree.depth = options.levels;
+  settings.sphereTree.medialSamples = options.medialSamples;
+  settings.sourceName = std::filesystem::path(options.meshPath).filename().string();
+
+  LoadedMesh loaded = loadMesh(options.meshPath);
+  const BakeResult result = bakeMesh(loaded.mesh, settings);
+
+  const auto writeStart = std::chrono::steady_clock::now();
+  const std::vector<std::byte> bytes = encodeBake(result.contents);
+  writeFileAtomically(options.outputPath, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+  const double writeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - writeStart).count();
+
+  const BakeContents& contents = result.contents;
+  const SphereTree& tree = contents.sphereTree;
+  const BakeFileReader file(bytes);
+
+  if (options.json) {
+    nlohmann::json out;
+    out["mesh"] = options.meshPath;
+    out["file"] = options.outputPath;
+    out["vertices"] = contents.mesh.vertexCount();
+    out["triangles"] = contents.mesh.triangleCount();
+    out["mesh_hash"] = hex64(contents.meshHash);  // a string: JSON numbers cannot carry 64 bits exactly
+    out["sign_method"] = signMethodName(result.signMethod);
+    out["method"] = sphereTreeMethodName(settings.sphereTree.method);
+    out["branching"] = settings.sphereTree.branching;
+    out["depth"] = settings.sphereTree.depth;
+    if (settings.sphereTree.method == SphereTreeMethod::kMedial) out["medial_samples"] = settings.sphereTree.medialSamples;
+    nlohmann::json levels = nlohmann::json::array();
+    for (std::uint32_t l = 0; l < result.levelFit.size(); ++l) {
+      const SphereTreeLevelFit& fit = result.levelFit[l];
+      levels.push_back({{"level", l}, {"spheres", fit.spheres}, {"fit_mean", fit.fitMean}, {"fit_max", fit.fitMax}});
+    }
+    out["levels"] = levels;
+    out["spheres"] = tree.sphereCount();
+    out["build_seconds"] = result.timings.buildSeconds;
+    out["distance_seconds"] = result.timings.distanceSeconds;
+    out["sphere_tree_seconds"] = result.timings.sphereTreeSeconds;
+    out["fit_seconds"] = result.timings.fitSeconds;
+    out["write_seconds"] = writeSeconds;
+    out["file_bytes"] = bytes.size();
+    nlohmann::json sections = nlohmann::json::array();
+    for (const BakeSectionEntry& e : file.entries()) {
+      sections.push_back({{"tag", bakeSectionTagName(e.tag)}, {"version", e.version}, {"bytes", e.size}});
+    }
+    out["sections"] = sections;
+    out["warnings"] = loaded.warnings;
+    printJson(out);
+    return 0;
+  }
+
+  for (const std::string& w : loaded.warnings) std::cerr << "clod: warning: " << w << "\n";
+  std::ostringstream text;
+  text << "baked " << options.meshPath << " -> " << options.outputPath << " (" << bytes.size() << " bytes) in "
+       << result.timings.buildSeconds << " s\n"
+       << "  mesh: " << contents.mesh.vertexCount() << " vertices, " << contents.mesh.triangleCount()
+       << " triangles, hash " << hex64(contents.meshHash) << ", sign " << signMethodName(result.signMethod) << "\n"
+       << "  sphere-tree: " << sphereTreeMethodName(settings.sphereTree.method) << ", branching "
+       << settings.sphereTree.branching << ", " << tree.levelCount() << " levels, " << tree.sphereCount()
+       << " spheres\n";
+  for (std::uint32_t l = 0; l < result.levelFit.size(); ++l) {
+    const SphereTreeLevelFit& fit = result.levelFit[l];
+    text << "    level " << l << ": " << fit.spheres << " spheres, fit mean " << fit.fitMean << ", max " << fit.fitMax
+         << " (of the bbox diagonal)\n";
+  }
+  std::cout << text.str();
+  return 0;
+}
+
+const CommandRegistration kRegistration("bake", [](CLI::App& app) {
+  auto options = std::make_shared<BakeOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "bake", "Build the sphere-tree (and later the other precomputed data) of a mesh and write a .clod bake file");
+  sub->add_option("mesh", options->meshPath, "Mesh file (OBJ, STL, PLY, OFF, glTF/GLB)")->required();
+  sub->add_option("-o,--output", options->outputPath, "Bake file to write (written atomically)")->required();
+  sub->add_option("--sphere-tree", options->method, "Sphere-tree builder")
+      ->check(CLI::IsMember({"octree", "medial"}))
+      ->capture_default_str();
+  sub->add_option("--branching", options->branching, "Maximum children per sphere, 2..64")->capture_default_str();
+  sub->add_option("--levels", options->levels,
+                  "Levels below the root (SphereTreeSettings::depth), 0..8; the tree and the JSON 'levels' "
+                  "array have L+1 levels, root first")
+      ->capture_default_str();
+  sub->add_option("--medial-samples", options->medialSamples,
+                  "Surface samples for the medial-axis builder, 100..2000000")
+      ->capture_default_str();
+  sub->add_flag("--json", options->json,
+                "Print one JSON object: levels[{level, spheres, fit_mean, fit_max}] (fit in units of the "
+                "bbox diagonal), build_seconds, file_bytes, mesh_hash, vertices, triangles, sign_method, "
+                "method, branching, ...");
+  return [options] { return runBake(*options); };
+});
+
+}  // namespace
+}  // namespace clod::cli
