@@ -175,7 +175,7 @@ MeshReport validateMesh(const TriangleMesh& mesh) {
   }
   if (r.nonManifoldVertices > 0)
     warn(plural(r.nonManifoldVertices, "non-manifold vertex", "non-manifold vertices") +
-         " (triangles around it form several fans), first: vertex " + std::to_string(firstNonManifoldVertex));
+         " (the triangles around each form several fans), first: vertex " + std::to_string(firstNonManifoldVertex));
   if (r.unreferencedVertices > 0)
     warn(plural(r.unreferencedVertices, "vertex is", "vertices are") + " used by no triangle");
 
