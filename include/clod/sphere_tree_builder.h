@@ -1,7 +1,20 @@
 #pragma once
 // Building sphere-trees (sphere_tree.h) from a mesh, and measuring how well they fit.
+//
+// Both builders guarantee coverage, not just sampled coverage: they partition the surface into
+// pieces (triangles clipped to axis-aligned boxes, so convex polygons of at most 9 corners) and
+// make every sphere contain every corner of every piece assigned to it. A sphere is convex, so
+// it contains the whole piece, and each level's pieces together are the whole surface. Radii are
+// finally grown by 1e-9 * (bounding-box diagonal) so that rounding in the containment test
+// cannot open a gap. Degenerate (zero-area) triangles are covered too.
+//
+// Typical use:
+//   clod::MeshDistance distance(clod::loadMesh("spot.obj").mesh);
+//   clod::SphereTree tree = clod::buildSphereTree(distance, {});             // medial, 8-ary, 4 levels
+//   std::vector<clod::SphereTreeLevelFit> fit = clod::measureSphereTreeFit(tree, distance);
 
 #include <cstdint>
+#include <string_view>
 #include <vector>
 
 #include "clod/mesh.h"
@@ -12,30 +25,82 @@ namespace clod {
 class MeshDistance;
 
 enum class SphereTreeMethod : std::uint8_t {
-  kOctree = 0,  ///< Hubbard's basic method: spheres around occupied octree cells, shrunk to fit
-  kMedial = 1,  ///< medial-axis approximation (Hubbard; Bradshaw & O'Sullivan)
+  /// Hubbard's basic method: the root cell is the cube around the bounding box; a sphere's
+  /// children are the occupied cells of its cell's subdivision, each the smallest enclosing
+  /// sphere (Welzl) of the surface clipped to the cell. With branching 8 a cell splits 2x2x2;
+  /// other branching factors split into the grid nx*ny*nz <= branching that halves the longest
+  /// extent first (2 -> 2x1x1, 4 -> 2x2x1, 27 -> 3x3x3). Empty cells get no sphere, so nodes
+  /// often have fewer children than the branching factor.
+  kOctree = 0,
+  /// Medial-axis approximation (Hubbard 1996; Bradshaw & O'Sullivan 2004, ACM TOG 23(1)):
+  /// surface samples -> qhull Delaunay tetrahedralisation -> interior Voronoi vertices = medial
+  /// spheres; every sample gets its inner pole (largest interior medial sphere touching it).
+  /// Top-down, each node's surface pieces are clustered (weighted k-means into `branching`
+  /// clusters) at points pulled halfway from the surface towards their poles, so both sides of a
+  /// thin part share a sphere; large pieces are split first. Each cluster gets the candidate
+  /// sphere with the lowest estimated fit (smallest enclosing sphere, sphere centred on the
+  /// cluster's medial points, or their midpoint), expanded to contain all its pieces.
+  /// Nodes get exactly `branching` children unless they hold too little surface to split.
+  kMedial = 1,
 };
 
 /// "octree" or "medial".
 const char* sphereTreeMethodName(SphereTreeMethod method) noexcept;
 
+/// Parses "octree" or "medial". Throws clod::Error(kInvalidArgument) naming the text otherwise.
+SphereTreeMethod parseSphereTreeMethod(std::string_view name);
+
 struct SphereTreeSettings {
   SphereTreeMethod method = SphereTreeMethod::kMedial;
-  std::uint32_t branching = 8;  ///< maximum children per sphere
-  std::uint32_t depth = 4;      ///< levels below the root (the tree has depth + 1 levels)
+  std::uint32_t branching = 8;  ///< maximum children per sphere, in [2, 64]
+  std::uint32_t depth = 4;      ///< levels below the root (the tree has depth + 1 levels), in [0, 8]
+  /// Medial builder: about this many area-weighted surface samples for the medial axis (plus all
+  /// vertices when there are no more than this many). In [100, 2,000,000]. Build time grows
+  /// roughly linearly with it (qhull's Delaunay is O(n log n) in practice).
+  std::uint32_t medialSamples = 20000;
 };
 
-/// Builds a sphere-tree. Throws clod::Error(kInvalidArgument) for out-of-range settings.
+/// Builds a sphere-tree of mesh.mesh() (see SphereTree for the layout and guarantees).
+/// Deterministic: the same mesh and settings give the same tree, with any number of threads.
+/// Runs in parallel with TBB over the nodes of a level.
+/// Cost: octree O(T * depth) clipping plus Welzl per cell; medial adds O(S log S) for the
+/// Delaunay of S samples and O(P * branching) k-means per level for P pieces.
+/// Throws clod::Error(kInvalidArgument) for out-of-range settings (the message names the
+/// setting), and kUnsupportedMesh if qhull fails on the samples.
 SphereTree buildSphereTree(const MeshDistance& mesh, const SphereTreeSettings& settings);
 
 /// Fit of one level: for every sphere, the greatest distance from its surface to the
 /// surface it bounds ("overshoot"), in units of the mesh's bounding-box diagonal.
 struct SphereTreeLevelFit {
   std::uint32_t spheres = 0;
-  double fitMean = 0.0;
-  double fitMax = 0.0;
+  double fitMean = 0.0;  ///< mean over the level's spheres of their fit
+  double fitMax = 0.0;   ///< largest fit of a sphere on the level
 };
 
+/// How the fit is estimated.
+struct SphereFitSettings {
+  /// Points per sphere surface (a spherical Fibonacci set), in [1, 100000]. Each point's
+  /// distance to the closest point of the sphere's triangles is exact; the sphere's fit is the
+  /// largest. The estimate is a lower bound of the true overshoot that converges as the count
+  /// grows: with N points every direction is within about 2*sqrt(4*pi/N) / 2 radians of one.
+  std::uint32_t samplesPerSphere = 200;
+};
+
+/// Fit of every sphere, in units of the bounding-box diagonal, indexed like the tree's spheres.
+/// Following Bradshaw's toolkit, a sphere's fit is the largest distance from a point on its
+/// surface to the closest point of the triangles it is responsible for (tree.triangles(i)).
+/// Cost: samplesPerSphere * (sum over spheres of their triangle counts) point-triangle
+/// distances, in parallel. Throws clod::Error(kInvalidArgument) if the tree is malformed for
+/// this mesh (a triangle index out of range, a sphere without triangles, inconsistent arrays)
+/// or the settings are out of range.
+std::vector<double> measureSphereFits(const SphereTree& tree, const MeshDistance& mesh,
+                                      const SphereFitSettings& settings);
+
+/// Per-level mean and max of measureSphereFits() with default settings.
 std::vector<SphereTreeLevelFit> measureSphereTreeFit(const SphereTree& tree, const MeshDistance& mesh);
+
+/// Same, with explicit fit settings.
+std::vector<SphereTreeLevelFit> measureSphereTreeFit(const SphereTree& tree, const MeshDistance& mesh,
+                                                     const SphereFitSettings& settings);
 
 }  // namespace clod

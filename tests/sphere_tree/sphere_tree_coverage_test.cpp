@@ -1,0 +1,85 @@
+// Property tests on the shared mesh corpus (closed, open, non-manifold) and on primitives:
+// every level of every tree covers the whole surface. Oracle: direct |p - c| <= r checks of
+// uniform area-weighted random surface points (plus every vertex and edge midpoint) against
+// the level's spheres. No tolerance: the builders promise exact coverage.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "clod/mesh_io.h"
+#include "clod/primitives.h"
+#include "clod/proximity.h"
+#include "clod/sphere_tree_builder.h"
+#include "sphere_tree_structure_check.h"
+#include "sphere_tree_test_support.h"
+
+namespace clod {
+namespace {
+
+void expectEveryLevelCovers(const SphereTree& tree, const std::vector<Vec3>& points) {
+  for (std::uint32_t l = 0; l < tree.levelCount(); ++l) {
+    const test::LevelSphereIndex index(tree, l);
+    std::size_t uncovered = 0;
+    for (const Vec3& p : points)
+      if (!index.covers(p) && ++uncovered <= 3)
+        ADD_FAILURE() << "level " << l << ": point (" << p.transpose() << ") is in no sphere";
+    EXPECT_EQ(uncovered, 0u) << "level " << l << " of " << points.size() << " points";
+  }
+}
+
+void checkBothBuilders(const TriangleMesh& mesh, std::size_t sampleCount) {
+  const MeshDistance distance(mesh);
+  const std::vector<Vec3> points = test::sampleSurfaceUniformly(mesh, sampleCount, 20260521);
+  for (SphereTreeMethod method : {SphereTreeMethod::kOctree, SphereTreeMethod::kMedial}) {
+    SCOPED_TRACE(sphereTreeMethodName(method));
+    SphereTreeSettings settings;  // defaults: 8-ary, 4 levels below the root
+    settings.method = method;
+    const SphereTree tree = buildSphereTree(distance, settings);
+    test::expectWellFormedTree(tree, distance.mesh(), settings);
+    expectEveryLevelCovers(tree, points);
+  }
+}
+
+class SharedMeshSphereTrees : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(SharedMeshSphereTrees, BothBuildersCoverEveryLevelAndKeepTheTreeInvariants) {
+  const std::string name = GetParam();
+  if (test::sanitizerScale() && name == "stanford-bunny.obj") GTEST_SKIP() << "69k triangles: Release run only";
+  const LoadedMesh loaded = loadMesh(std::filesystem::path(CLOD_SHARED_MESH_DIR) / name);
+  checkBothBuilders(loaded.mesh, test::sanitizerScale() ? 5000 : 50000);
+}
+
+INSTANTIATE_TEST_SUITE_P(Corpus, SharedMeshSphereTrees,
+                         ::testing::Values("spot.obj", "fandisk.obj", "rocker-arm.obj", "cow.obj", "bunny-1500.obj",
+                                           "teapot.obj", "suzanne.obj", "stanford-bunny.obj"),
+                         test::meshParamName);
+
+TEST(PrimitiveSphereTrees, BothBuildersCoverBoxesIcospheresAndCylinders) {
+  const std::size_t samples = test::sanitizerScale() ? 3000 : 20000;
+  {
+    SCOPED_TRACE("flat box");
+    checkBothBuilders(makeBox(Vec3(2.0, 1.0, 0.05)), samples);
+  }
+  {
+    SCOPED_TRACE("icosphere");
+    checkBothBuilders(makeIcosphere(1.5, 3), samples);
+  }
+  {
+    SCOPED_TRACE("cylinder");
+    checkBothBuilders(makeCylinder(0.3, 3.0, 32), samples);
+  }
+}
+
+TEST(PrimitiveSphereTrees, DegenerateTrianglesAreAssignedAndCovered) {
+  // A box plus a zero-area sliver triangle (three collinear points) sticking out of it.
+  TriangleMesh mesh = makeBox(Vec3(1, 1, 1));
+  const auto base = mesh.vertexCount();
+  mesh.vertices.push_back(Vec3(1.0, 0.0, 0.0));
+  mesh.vertices.push_back(Vec3(1.5, 0.0, 0.0));
+  mesh.vertices.push_back(Vec3(2.0, 0.0, 0.0));
+  mesh.triangles.push_back({base, base + 1, base + 2});
+  checkBothBuilders(mesh, 2000);
+}
+
+}  // namespace
+}  // namespace clod

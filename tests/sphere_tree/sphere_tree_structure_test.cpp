@@ -1,0 +1,103 @@
+// Structural invariants of built sphere-trees, and settings validation.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
+
+#include "clod/error.h"
+#include "clod/primitives.h"
+#include "clod/proximity.h"
+#include "clod/sphere_tree_builder.h"
+#include "sphere_tree_structure_check.h"
+
+namespace clod {
+namespace {
+
+TEST(SphereTreeMethod, NamesRoundTripAndUnknownNamesAreRejected) {
+  for (SphereTreeMethod m : {SphereTreeMethod::kOctree, SphereTreeMethod::kMedial})
+    EXPECT_EQ(parseSphereTreeMethod(sphereTreeMethodName(m)), m);
+  try {
+    parseSphereTreeMethod("voronoi");
+    FAIL() << "no exception";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+    EXPECT_NE(std::string(e.what()).find("voronoi"), std::string::npos);
+  }
+}
+
+TEST(SphereTreeBuilder, OutOfRangeSettingsThrowInvalidArgumentNamingTheSetting) {
+  const MeshDistance box(makeBox(Vec3(1, 2, 3)));
+  struct Case {
+    SphereTreeSettings settings;
+    const char* name;
+  };
+  std::vector<Case> cases;
+  SphereTreeSettings s;
+  s.branching = 1;
+  cases.push_back({s, "branching"});
+  s = {};
+  s.branching = 65;
+  cases.push_back({s, "branching"});
+  s = {};
+  s.depth = 9;
+  cases.push_back({s, "depth"});
+  s = {};
+  s.medialSamples = 10;
+  cases.push_back({s, "medialSamples"});
+  for (const Case& c : cases) {
+    try {
+      buildSphereTree(box, c.settings);
+      ADD_FAILURE() << "no exception for " << c.name;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+      EXPECT_NE(std::string(e.what()).find(c.name), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(SphereTreeBuilder, TreesHaveConsistentLevelsChildrenParentsAndTriangleListsForAnyBranching) {
+  const MeshDistance sphere(makeIcosphere(1.0, 3));
+  const MeshDistance cylinder(makeCylinder(0.5, 2.0, 24));
+  for (const MeshDistance* mesh : {&sphere, &cylinder})
+    for (SphereTreeMethod method : {SphereTreeMethod::kOctree, SphereTreeMethod::kMedial})
+      for (std::uint32_t branching : {2u, 4u, 8u, 27u})
+        for (std::uint32_t depth : {0u, 1u, 3u}) {
+          SCOPED_TRACE(std::string(sphereTreeMethodName(method)) + " branching " + std::to_string(branching) +
+                       " depth " + std::to_string(depth));
+          SphereTreeSettings settings;
+          settings.method = method;
+          settings.branching = branching;
+          settings.depth = depth;
+          settings.medialSamples = 2000;
+          const SphereTree tree = buildSphereTree(*mesh, settings);
+          test::expectWellFormedTree(tree, mesh->mesh(), settings);
+        }
+}
+
+TEST(SphereTreeBuilder, MedialNodesUseTheFullBranchingFactorWhenThereIsEnoughSurface) {
+  // An icosphere of 1280 triangles has far more surface than 8^3 clusters need.
+  const MeshDistance sphere(makeIcosphere(1.0, 3));
+  SphereTreeSettings settings;
+  settings.depth = 3;
+  settings.medialSamples = 4000;
+  const SphereTree tree = buildSphereTree(sphere, settings);
+  for (std::uint32_t l = 0; l <= 3; ++l) EXPECT_EQ(tree.levelEnd(l) - tree.levelBegin(l), std::uint32_t(1) << (3 * l));
+}
+
+TEST(SphereTreeBuilder, BuildsAreDeterministic) {
+  const MeshDistance cylinder(makeCylinder(0.5, 2.0, 24));
+  for (SphereTreeMethod method : {SphereTreeMethod::kOctree, SphereTreeMethod::kMedial}) {
+    SphereTreeSettings settings;
+    settings.method = method;
+    settings.medialSamples = 2000;
+    const SphereTree a = buildSphereTree(cylinder, settings);
+    const SphereTree b = buildSphereTree(cylinder, settings);
+    EXPECT_EQ(a.radius, b.radius);
+    EXPECT_EQ(a.centerX, b.centerX);
+    EXPECT_EQ(a.triangleList, b.triangleList);
+    EXPECT_EQ(a.levelOffsets, b.levelOffsets);
+  }
+}
+
+}  // namespace
+}  // namespace clod
