@@ -88,7 +88,7 @@ struct PaperFormulaMissStats {
 };
 
 /// Measures PaperFormulaMissStats over `queries` uniformly random directions (fixed `seed`, so
-/// deterministic). CLOD_ASSERT: a ring scheme.
+/// deterministic), comparing with nearest() (exact). O(queries). CLOD_ASSERT: a ring scheme.
 PaperFormulaMissStats measurePaperFormulaMisses(const SphereSampling& sampling, std::uint64_t queries,
                                                 std::uint64_t seed);
 
