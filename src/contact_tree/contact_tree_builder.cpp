@@ -98,6 +98,23 @@ void Builder::processCell(const PendingCell& cell, std::uint32_t depth, CellResu
 
   // Exact values at the 27 lattice points (8 known) and at the 8 octant centres.
   r.measured = true;
+  // Exact signed distance at local position t (in cell units). The sign is the expensive part
+  // of an exact query for open meshes (a winding number), and often it is already known: if a
+  // corner value v has |v| > |x - corner|, d(x) has v's sign, since |d(x) - v| <= |x - corner|.
+  // Then only the unsigned distance is needed.
+  auto exactAt = [&](const Vec3& t) {
+    const Vec3 p = cellMin + h * t;
+    ++r.queries;
+    for (int c = 0; c < 8; ++c) {
+      const double reach = h * (t - Vec3(c & 1, (c >> 1) & 1, (c >> 2) & 1)).norm();
+      const double v = cell.corners[c];
+      if (std::abs(v) * (1.0 - 1e-6) > reach + 1e-9 * h) {
+        const double unsignedDistance = distance_.closestPoint(p).distance;
+        return v < 0.0 ? -unsignedDistance : unsignedDistance;
+      }
+    }
+    return distance_.signedDistance(p);
+  };
   double exact[kLatticeSize];
   MeshDistance::Signed centre{};
   for (int l = 0; l < kLatticeSize; ++l) {
@@ -107,21 +124,17 @@ void Builder::processCell(const PendingCell& cell, std::uint32_t depth, CellResu
       exact[l] = cell.corners[c];
       continue;
     }
-    const Vec3 p = cellMin + 0.5 * h * Vec3(i, j, k);
     if (l == 13) {
-      centre = distance_.signedQuery(p);
+      centre = distance_.signedQuery(cellMin + 0.5 * h * Vec3(i, j, k));
       exact[l] = centre.signedDistance;
+      ++r.queries;
     } else {
-      exact[l] = distance_.signedDistance(p);
+      exact[l] = exactAt(0.5 * Vec3(i, j, k));
     }
-    ++r.queries;
   }
   double octantCentre[8];
-  for (int o = 0; o < 8; ++o) {
-    const Vec3 t(0.25 + 0.5 * (o & 1), 0.25 + 0.5 * ((o >> 1) & 1), 0.25 + 0.5 * ((o >> 2) & 1));
-    octantCentre[o] = distance_.signedDistance(cellMin + h * t);
-    ++r.queries;
-  }
+  for (int o = 0; o < 8; ++o)
+    octantCentre[o] = exactAt(Vec3(0.25 + 0.5 * (o & 1), 0.25 + 0.5 * ((o >> 1) & 1), 0.25 + 0.5 * ((o >> 2) & 1)));
 
   // Interpolation error at the test points, overall and restricted to the band. A band point
   // is within 0.28 h of a test point (covering radius of this body-centred lattice), so a
