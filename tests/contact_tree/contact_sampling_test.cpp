@@ -1,0 +1,175 @@
+// Contact sampling between two contact trees, on boxes whose contact has an analytic answer.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "clod/contact_sampling.h"
+#include "clod/contact_tree_builder.h"
+#include "clod/error.h"
+#include "clod/primitives.h"
+#include "clod/proximity.h"
+
+namespace clod {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct Boxes {
+  Vec3 halfA = Vec3::Constant(0.5);  // the upper, smaller box
+  Vec3 halfB = Vec3::Constant(1.0);  // the lower box, at the origin
+  ContactTree treeA, treeB;
+  Boxes() {
+    ContactTreeSettings settings;
+    settings.errorRel = 2e-3;
+    treeA = buildContactTree(MeshDistance(makeBox(halfA)), settings);
+    treeB = buildContactTree(MeshDistance(makeBox(halfB)), settings);
+  }
+};
+
+const Boxes& boxes() {
+  static const Boxes b;
+  return b;
+}
+
+// Pose of A resting on B's top face with its bottom `penetration` below it, rotated by `yaw`
+// about z and centred at (x, y).
+Pose restingPose(double x, double y, double yaw, double penetration) {
+  Pose pose;
+  pose.rotation = Quat(Eigen::AngleAxisd(yaw, Vec3::UnitZ()));
+  pose.translation = Vec3(x, y, boxes().halfB.z() + boxes().halfA.z() - penetration);
+  return pose;
+}
+
+// The overlap region of a resting A (wholly above B's top face) is A's bottom face.
+std::vector<Vec3> bottomCorners(const Pose& pose) {
+  const Vec3 h = boxes().halfA;
+  std::vector<Vec3> corners;
+  for (double sx : {-1.0, 1.0})
+    for (double sy : {-1.0, 1.0}) corners.push_back(pose.apply(Vec3(sx * h.x(), sy * h.y(), -h.z())));
+  return corners;
+}
+
+void expectRestingContacts(const Pose& poseA, double penetration) {
+  const Boxes& b = boxes();
+  ContactSamplingSettings settings;
+  std::vector<ContactPoint> contacts;
+  ContactQueryStats stats;
+  findContacts(b.treeA, poseA, b.treeB, Pose{}, settings, contacts, &stats);
+  // Raw samples cover the whole face; thinning leaves one patch of four.
+  EXPECT_GT(stats.rawContacts, 20u);
+  ASSERT_GE(contacts.size(), 4u);
+  EXPECT_LE(contacts.size(), 8u);
+  const double tolerance = b.treeB.errorAbs + b.treeA.errorAbs;
+  for (const ContactPoint& c : contacts) {
+    EXPECT_GT(c.normal.z(), std::cos(kPi / 180.0)) << "normal " << c.normal.transpose() << " at " << c.point.transpose();
+    EXPECT_NEAR(c.depth, penetration, tolerance) << c.point.transpose();
+  }
+  // "Spread to the corners": each corner of the overlap has a contact within 5 % of the
+  // overlap's side (1.0 here): the sampling spacing near a corner is a fraction of that.
+  for (const Vec3& corner : bottomCorners(poseA)) {
+    double nearest = 1e9;
+    for (const ContactPoint& c : contacts) nearest = std::min(nearest, (c.point - corner).head<2>().norm());
+    EXPECT_LT(nearest, 0.05) << "corner " << corner.transpose();
+  }
+}
+
+TEST(ContactSampling, BoxRestingOnBoxGetsFourContactsAtTheOverlapCorners) {
+  expectRestingContacts(restingPose(0.3, -0.2, 0.0, 1e-3), 1e-3);
+}
+
+TEST(ContactSampling, RotatedBoxRestingOnBoxKeepsFaceNormalsAndCorners) {
+  expectRestingContacts(restingPose(0.1, 0.05, 30.0 * kPi / 180.0, 2e-3), 2e-3);
+}
+
+TEST(ContactSampling, TiltedLowerBoxStillGivesItsFaceNormal) {
+  // The whole scene rotated: B tilted by 20 degrees about x, A resting on it.
+  Pose tilt;
+  tilt.rotation = Quat(Eigen::AngleAxisd(20.0 * kPi / 180.0, Vec3::UnitX()));
+  const Pose poseA = tilt * restingPose(-0.1, 0.2, 0.4, 1e-3);
+  std::vector<ContactPoint> contacts;
+  findContacts(boxes().treeA, poseA, boxes().treeB, tilt, ContactSamplingSettings{}, contacts);
+  ASSERT_GE(contacts.size(), 4u);
+  const Vec3 up = tilt.rotation * Vec3::UnitZ();
+  for (const ContactPoint& c : contacts) EXPECT_GT(c.normal.dot(up), std::cos(kPi / 180.0));
+}
+
+TEST(ContactSampling, SeparatedBoxesGetContactsOnlyWithinTheMargin) {
+  const Boxes& b = boxes();
+  const Pose poseA = restingPose(0.0, 0.0, 0.0, -0.01);  // 0.01 gap
+  std::vector<ContactPoint> contacts;
+  findContacts(b.treeA, poseA, b.treeB, Pose{}, ContactSamplingSettings{}, contacts);
+  EXPECT_TRUE(contacts.empty());
+  ContactSamplingSettings withMargin;
+  withMargin.marginAbs = 0.02;
+  findContacts(b.treeA, poseA, b.treeB, Pose{}, withMargin, contacts);
+  ASSERT_GE(contacts.size(), 4u);
+  for (const ContactPoint& c : contacts) {
+    EXPECT_NEAR(c.depth, -0.01, b.treeA.errorAbs + b.treeB.errorAbs);
+    EXPECT_GT(c.normal.z(), std::cos(kPi / 180.0));
+  }
+}
+
+TEST(ContactSampling, DeeplyInterpenetratingBoxesStillGetContacts) {
+  // A sunk 0.3 into B: far outside the 1 % band, where only the coarse field exists.
+  const Boxes& b = boxes();
+  std::vector<ContactPoint> contacts;
+  ContactQueryStats stats;
+  findContacts(b.treeA, restingPose(0.0, 0.0, 0.0, 0.3), b.treeB, Pose{}, ContactSamplingSettings{}, contacts, &stats);
+  ASSERT_FALSE(contacts.empty());
+  bool upward = false;
+  for (const ContactPoint& c : contacts) {
+    EXPECT_GT(c.depth, 0.0);
+    // No point of either box is deeper than 0.3 + the cells' error bounds inside the other.
+    EXPECT_LE(c.depth, 0.3 + c.errorBound + 1e-6);
+    upward = upward || (c.normal.z() > std::cos(kPi / 180.0) && std::abs(c.depth - 0.3) <= c.errorBound + 1e-3);
+  }
+  EXPECT_TRUE(upward) << "the bottom face must be pushed up by the penetration depth";
+  // Inside, the coarse field's gradient turns between faces near the medial surfaces, so there
+  // are more patches than faces, but thinning must still remove the bulk of the samples.
+  EXPECT_LE(contacts.size() * 10, stats.rawContacts) << contacts.size() << " of " << stats.rawContacts;
+}
+
+TEST(ContactReduction, PlanarGridKeepsItsFourCorners) {
+  std::vector<ContactPoint> contacts;
+  for (int i = 0; i <= 10; ++i)
+    for (int j = 0; j <= 10; ++j) contacts.push_back({Vec3(i * 0.1, j * 0.1, 0.0), Vec3::UnitZ(), 0.01, 0.0, 0});
+  reduceContacts(contacts, ContactSamplingSettings{});
+  ASSERT_EQ(contacts.size(), 4u);
+  for (const Vec3& corner : {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0)}) {
+    bool found = false;
+    for (const ContactPoint& c : contacts) found = found || (c.point - corner).norm() < 1e-12;
+    EXPECT_TRUE(found) << corner.transpose();
+  }
+}
+
+TEST(ContactReduction, OpposingNormalsFormSeparatePatches) {
+  std::vector<ContactPoint> contacts;
+  for (int i = 0; i < 10; ++i) {
+    contacts.push_back({Vec3(i, 0, 0), Vec3::UnitZ(), 0.1, 0.0, 0});
+    contacts.push_back({Vec3(i, 5, 0), -Vec3::UnitZ(), 0.2, 0.0, 0});
+  }
+  ContactSamplingSettings settings;
+  settings.maxContactsPerPatch = 2;
+  reduceContacts(contacts, settings);
+  ASSERT_EQ(contacts.size(), 4u);
+  int up = 0;
+  for (const ContactPoint& c : contacts) up += c.normal.z() > 0;
+  EXPECT_EQ(up, 2);
+}
+
+TEST(ContactSampling, RejectsOutOfRangeSettings) {
+  ContactSamplingSettings settings;
+  settings.samplesPerCellAxis = 0;
+  std::vector<ContactPoint> contacts;
+  try {
+    findContacts(boxes().treeA, Pose{}, boxes().treeB, Pose{}, settings, contacts);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+    EXPECT_NE(std::string(e.what()).find("samplesPerCellAxis"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace clod
