@@ -54,12 +54,18 @@ enum class SamplingScheme : std::uint8_t {
   /// RING ordering of HEALPix (rings north to south, theta increasing within a ring), which is
   /// what makes the O(1) ring lookup possible; NESTED ordering is not provided (yet).
   kHealpix = 3,
+  /// Spherical Fibonacci point set (Keinert et al., "Spherical Fibonacci Mapping", ACM TOG 34(6)
+  /// 2015, eq. 2): resolution = the number of samples n, any n >= 1 (so sample counts can match
+  /// another scheme exactly). Sample i: z = 1 - (2i+1)/n, theta = 2 pi frac(i / golden ratio);
+  /// index = i (north to south). Near-uniform (every sample owns an equal-area z band).
+  /// Retrieval through the same cube-map candidate grid as geodesic (not Keinert's inverse map).
+  kFibonacci = 4,
 };
 
 /// All schemes, in enum order.
 std::span<const SamplingScheme> allSamplingSchemes() noexcept;
 
-/// CLI / file name of a scheme: "polar", "adaptive-polar", "geodesic", "healpix".
+/// CLI / file name of a scheme: "polar", "adaptive-polar", "geodesic", "healpix", "fibonacci".
 std::string_view samplingSchemeName(SamplingScheme scheme) noexcept;
 
 /// Inverse of samplingSchemeName (exact, case-sensitive). Throws clod::Error(kInvalidArgument)
@@ -67,8 +73,9 @@ std::string_view samplingSchemeName(SamplingScheme scheme) noexcept;
 SamplingScheme parseSamplingScheme(std::string_view name);
 
 /// Largest accepted resolution per scheme (stacks for the polar schemes, subdivision frequency
-/// for geodesic, N_side for HEALPix). Chosen so that a sampling stays below ~1.1 M samples and
-/// the geodesic lookup grid builds in about a second.
+/// for geodesic, N_side for HEALPix, sample count for Fibonacci): 1024, 1024, 64, 256, 16384.
+/// Chosen so that a sampling stays below ~1.1 M samples and the candidate grids of geodesic and
+/// Fibonacci build in about a second.
 int maxSamplingResolution(SamplingScheme scheme) noexcept;
 
 /// Progressive refinement (paper section 5, Table 1): a sphere `level` levels below the root
@@ -87,18 +94,20 @@ std::uint32_t samplingSampleCount(SamplingScheme scheme, int resolution);
 ///   polar, adaptive polar: S itself;
 ///   geodesic, HEALPix: the resolution >= 1 whose sample count is closest to the adaptive-polar
 ///   count at S (ties to the smaller), e.g. S = 10 (65 samples) -> geodesic f = 2 (42),
-///   HEALPix N = 2 (48). So geodesic/HEALPix never have fewer than 12 samples.
+///   HEALPix N = 2 (48). So geodesic/HEALPix never have fewer than 12 samples;
+///   Fibonacci: exactly the adaptive-polar count (65 at S = 10), at most its maximum resolution.
 /// Throws clod::Error(kInvalidArgument) if stacks is outside [1, maxSamplingResolution(kPolar)].
 int samplingResolutionForStacks(SamplingScheme scheme, int stacks);
 
 /// An immutable set of unit directions plus the tables its nearest-sample lookup needs.
 /// Memory: 24 bytes per sample (SoA doubles) + for ring schemes ~40 bytes per ring + for
-/// geodesic the lookup grid (about 4 cells per sample, ~25 candidate indices per sample in all).
+/// geodesic and Fibonacci the lookup grid (about 4 cells per sample, 100-160 bytes per sample).
 class SphereSampling {
 public:
   /// Builds `scheme` at `resolution` (stacks S for the polar schemes, frequency f for geodesic,
-  /// N_side for HEALPix). Cost: O(samples) for ring schemes; O(samples^2 / 8) for geodesic
-  /// (its candidate grid, parallel with TBB). Throws clod::Error(kInvalidArgument) if resolution
+  /// N_side for HEALPix, sample count for Fibonacci). Cost: O(samples) for ring schemes;
+  /// O(samples^2) for geodesic (~samples^2 / 2) and Fibonacci (~4 samples^2): their candidate
+  /// grids, built in parallel with TBB. Throws clod::Error(kInvalidArgument) if resolution
   /// is outside [1, maxSamplingResolution(scheme)].
   static SphereSampling build(SamplingScheme scheme, int resolution);
 
@@ -124,7 +133,7 @@ public:
   ///   bracketing theta are tested, until a ring's best possible dot product
   ///   cos(phi - phi_ring) cannot beat the best found. This visits 2-4 rings in practice and is
   ///   exact, unlike rounding phi then theta (see nearestPaperFormula).
-  ///   Geodesic: O(1) via a cube map with about 4 cells per sample; each cell lists every sample
+  ///   Geodesic, Fibonacci: O(1) via a cube map with about 4 cells per sample; each cell lists every sample
   ///   that is nearest to some direction in the cell (a superset, by the triangle inequality:
   ///   d(c, s) <= d_min(c) + 2 r_cell for cell centre c and cell radius r_cell); the list
   ///   (typically 4-8 samples) is scanned.
@@ -147,7 +156,7 @@ public:
   /// ties). O(samples). Any scheme.
   std::uint32_t nearestLinearScan(const Vec3& unitDirection) const noexcept;
 
-  /// Ring layout (ring schemes only; 0 for geodesic): rings are ordered north to south, the
+  /// Ring layout (ring schemes only; 0 for geodesic and Fibonacci): rings are ordered north to south, the
   /// samples of ring k are indices ringOffset(k) .. ringOffset(k) + ringSize(k) - 1 with
   /// theta_j = (j + ringThetaShift(k)) * 2pi / ringSize(k).
   std::uint32_t ringCount() const noexcept { return static_cast<std::uint32_t>(ringSize_.size()); }
@@ -171,9 +180,11 @@ private:
   void buildPolarRings(bool adaptive);      // sampling_rings.cpp
   void buildHealpixRings();                 // sampling_rings.cpp
   void buildGeodesic();                     // sampling_geodesic.cpp
+  void buildFibonacci();                    // sampling_fibonacci.cpp
+  void buildCandidateGrid();                // sampling_grid.cpp
   std::uint32_t nearestInRings(const Vec3& u) const noexcept;       // sampling_rings.cpp
   std::uint32_t closestRingByFormula(double z, double rho) const noexcept;
-  std::uint32_t nearestInGrid(const Vec3& u) const noexcept;        // sampling_geodesic.cpp
+  std::uint32_t nearestInGrid(const Vec3& u) const noexcept;        // sampling_grid.cpp
   std::uint32_t gridCell(const Vec3& u) const noexcept;
 
   SamplingScheme scheme_ = SamplingScheme::kPolar;

@@ -1,22 +1,16 @@
 // Geodesic scheme: a frequency-f subdivided icosahedron projected onto the sphere, its covering
-// radius, the paper's octant ("quadrant of the hemisphere") retrieval and a cube-map grid of
-// candidate lists for O(1) retrieval.
+// radius and the paper's octant ("quadrant of the hemisphere") retrieval. The default O(1)
+// retrieval is the cube-map candidate grid of sampling_grid.cpp.
 //
-// Both retrievals are exact because their candidate lists are supersets derived from two facts:
-//  * every direction u lies in some spherical triangle of the subdivision and is within that
-//    triangle's circumradius of one of its corners, so its nearest sample is within R (the
-//    largest circumradius, "covering radius") of u;
-//  * by the triangle inequality on great-circle angles, if u is within r of a point c, its
-//    nearest sample s* satisfies d(c, s*) <= d(u, s*) + r <= d(u, s_c) + r <= d_min(c) + 2r,
-//    where s_c is the sample nearest to c.
+// The octant lists are exact supersets: every direction u lies in some spherical triangle of the
+// subdivision and is within that triangle's circumradius of one of its corners, so its nearest
+// sample is within R (the largest circumradius, "covering radius") of u, and hence within R of
+// u's octant.
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include "clod/error.h"
 #include "clod/sphere_sampling.h"
@@ -175,80 +169,7 @@ void SphereSampling::buildGeodesic() {
     octantStart_.push_back(static_cast<std::uint32_t>(octantSamples_.size()));
   }
 
-  // Cube-map grid with about 4 cells per sample, so each cell's list stays short. Even side:
-  // the planes x = 0, y = 0, z = 0 fall on cell boundaries, so every cell lies in one octant.
-  const auto side = static_cast<std::uint32_t>(2 * std::max(1, static_cast<int>(std::ceil(std::sqrt(size() / 6.0)))));
-  gridSide_ = side;
-  const std::uint32_t cellCount = 6 * side * side;
-  std::vector<std::vector<std::uint32_t>> cellLists(cellCount);
-  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, cellCount), [&](const tbb::blocked_range<std::uint32_t>& range) {
-    for (std::uint32_t cell = range.begin(); cell != range.end(); ++cell) {
-      const std::uint32_t face = cell / (side * side);
-      const std::uint32_t ci = (cell / side) % side, cj = cell % side;
-      const int axis = static_cast<int>(face / 2);
-      const double sign = (face % 2) ? -1.0 : 1.0;
-      auto cellPoint = [&](double s, double t) {
-        Vec3 p;
-        p[axis] = sign;
-        p[(axis + 1) % 3] = s;
-        p[(axis + 2) % 3] = t;
-        return p.normalized();
-      };
-      auto coord = [&](double c) { return -1.0 + 2.0 * c / side; };
-      const Vec3 centre = cellPoint(coord(ci + 0.5), coord(cj + 0.5));
-      // Over a cube-face cell the angle to the centre is largest at a corner: the set of points
-      // of the face plane within an angle < 90 degrees of the centre is convex (a conic section).
-      double cellRadius = 0.0;
-      for (int corner = 0; corner < 4; ++corner) {
-        cellRadius = std::max(cellRadius, angleBetween(centre, cellPoint(coord(ci + (corner & 1)), coord(cj + (corner >> 1)))));
-      }
-      const int octant = octantOf(centre);
-      double bestDot = -2.0;
-      for (std::uint32_t k = octantStart_[octant]; k < octantStart_[octant + 1]; ++k) {
-        bestDot = std::max(bestDot, direction(octantSamples_[k]).dot(centre));
-      }
-      const double limit = std::acos(std::clamp(bestDot, -1.0, 1.0)) + 2.0 * cellRadius + kAngleSlack;
-      const double cosLimit = std::cos(std::min(limit, M_PI));
-      auto& list = cellLists[cell];
-      for (std::uint32_t k = octantStart_[octant]; k < octantStart_[octant + 1]; ++k) {
-        if (direction(octantSamples_[k]).dot(centre) >= cosLimit) list.push_back(octantSamples_[k]);
-      }
-    }
-  });
-  cellStart_.reserve(cellCount + 1);
-  cellStart_.push_back(0);
-  for (const auto& list : cellLists) {
-    cellSamples_.insert(cellSamples_.end(), list.begin(), list.end());
-    cellStart_.push_back(static_cast<std::uint32_t>(cellSamples_.size()));
-  }
-}
-
-std::uint32_t SphereSampling::gridCell(const Vec3& u) const noexcept {
-  const Vec3 a = u.cwiseAbs();
-  const int axis = (a.x() >= a.y() && a.x() >= a.z()) ? 0 : (a.y() >= a.z() ? 1 : 2);
-  const double inv = 1.0 / a[axis];
-  const std::uint32_t face = 2 * static_cast<std::uint32_t>(axis) + (u[axis] < 0.0 ? 1 : 0);
-  const double half = 0.5 * gridSide_;
-  auto cellCoord = [&](double c) {
-    const auto k = static_cast<std::int64_t>((c * inv + 1.0) * half);
-    return static_cast<std::uint32_t>(std::clamp<std::int64_t>(k, 0, gridSide_ - 1));
-  };
-  return (face * gridSide_ + cellCoord(u[(axis + 1) % 3])) * gridSide_ + cellCoord(u[(axis + 2) % 3]);
-}
-
-std::uint32_t SphereSampling::nearestInGrid(const Vec3& u) const noexcept {
-  const std::uint32_t cell = gridCell(u);
-  std::uint32_t best = 0;
-  double bestDot = -2.0;
-  for (std::uint32_t k = cellStart_[cell]; k < cellStart_[cell + 1]; ++k) {
-    const std::uint32_t s = cellSamples_[k];
-    const double d = x_[s] * u.x() + y_[s] * u.y() + z_[s] * u.z();
-    if (d > bestDot) {
-      bestDot = d;
-      best = s;
-    }
-  }
-  return best;
+  buildCandidateGrid();
 }
 
 std::uint32_t SphereSampling::nearestQuadrantSearch(const Vec3& u) const noexcept {

@@ -153,7 +153,7 @@ std::uint32_t SphereSampling::nearestInRings(const Vec3& u) const noexcept {
 }
 
 std::uint32_t SphereSampling::nearestPaperFormula(const Vec3& u) const noexcept {
-  CLOD_ASSERT(scheme_ != SamplingScheme::kGeodesic);
+  CLOD_ASSERT(ringCount() > 0);
   const double rho = std::sqrt(u.x() * u.x() + u.y() * u.y());
   const std::uint32_t ring = closestRingByFormula(u.z(), rho);
   double theta = std::atan2(u.y(), u.x());

@@ -165,7 +165,7 @@ std::vector<SamplingTable1Row> computeSamplingTable1() {
 
 PaperFormulaMissStats measurePaperFormulaMisses(const SphereSampling& sampling, std::uint64_t queries,
                                                 std::uint64_t seed) {
-  CLOD_ASSERT(sampling.scheme() != SamplingScheme::kGeodesic);
+  CLOD_ASSERT(sampling.ringCount() > 0);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> gauss;
   PaperFormulaMissStats stats;

@@ -2,6 +2,7 @@
 // ring (sampling_rings.cpp) and geodesic (sampling_geodesic.cpp) implementations.
 #include "clod/sphere_sampling.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
@@ -12,9 +13,9 @@
 namespace clod {
 namespace {
 
-constexpr std::array<SamplingScheme, 4> kAllSchemes = {
+constexpr std::array<SamplingScheme, 5> kAllSchemes = {
     SamplingScheme::kPolar, SamplingScheme::kAdaptivePolar, SamplingScheme::kGeodesic,
-    SamplingScheme::kHealpix};
+    SamplingScheme::kHealpix, SamplingScheme::kFibonacci};
 
 void checkResolution(SamplingScheme scheme, int resolution) {
   int maxResolution = maxSamplingResolution(scheme);
@@ -44,6 +45,7 @@ std::string_view samplingSchemeName(SamplingScheme scheme) noexcept {
     case SamplingScheme::kAdaptivePolar: return "adaptive-polar";
     case SamplingScheme::kGeodesic: return "geodesic";
     case SamplingScheme::kHealpix: return "healpix";
+    case SamplingScheme::kFibonacci: return "fibonacci";
   }
   return "unknown";
 }
@@ -67,6 +69,7 @@ int maxSamplingResolution(SamplingScheme scheme) noexcept {
     case SamplingScheme::kAdaptivePolar: return 1024;  // ~667,000 samples
     case SamplingScheme::kGeodesic: return 64;         // 40,962 samples (grid build ~1 s)
     case SamplingScheme::kHealpix: return 256;         // 786,432 samples
+    case SamplingScheme::kFibonacci: return 16384;     // samples (grid build ~1 s)
   }
   return 0;
 }
@@ -91,6 +94,7 @@ std::uint32_t samplingSampleCount(SamplingScheme scheme, int resolution) {
     }
     case SamplingScheme::kGeodesic: return 10 * r * r + 2;
     case SamplingScheme::kHealpix: return 12 * r * r;
+    case SamplingScheme::kFibonacci: return r;
   }
   return 0;
 }
@@ -99,6 +103,9 @@ int samplingResolutionForStacks(SamplingScheme scheme, int stacks) {
   checkResolution(SamplingScheme::kPolar, stacks);
   if (scheme == SamplingScheme::kPolar || scheme == SamplingScheme::kAdaptivePolar) return stacks;
   long target = samplingSampleCount(SamplingScheme::kAdaptivePolar, stacks);
+  if (scheme == SamplingScheme::kFibonacci) {
+    return static_cast<int>(std::min<long>(target, maxSamplingResolution(scheme)));
+  }
   int best = 1;
   long bestDiff = std::labs(static_cast<long>(samplingSampleCount(scheme, 1)) - target);
   for (int r = 2; r <= maxSamplingResolution(scheme); ++r) {
@@ -127,6 +134,7 @@ SphereSampling SphereSampling::build(SamplingScheme scheme, int resolution) {
     case SamplingScheme::kAdaptivePolar: sampling.buildPolarRings(true); break;
     case SamplingScheme::kGeodesic: sampling.buildGeodesic(); break;
     case SamplingScheme::kHealpix: sampling.buildHealpixRings(); break;
+    case SamplingScheme::kFibonacci: sampling.buildFibonacci(); break;
   }
   CLOD_ASSERT(sampling.size() == count);
   return sampling;
@@ -149,7 +157,9 @@ Vec3 SphereSampling::direction(std::uint32_t index) const noexcept {
 
 std::uint32_t SphereSampling::nearest(const Vec3& unitDirection) const noexcept {
   CLOD_ASSERT(std::abs(unitDirection.squaredNorm() - 1.0) < 2e-6);
-  if (scheme_ == SamplingScheme::kGeodesic) return nearestInGrid(unitDirection);
+  if (scheme_ == SamplingScheme::kGeodesic || scheme_ == SamplingScheme::kFibonacci) {
+    return nearestInGrid(unitDirection);
+  }
   return nearestInRings(unitDirection);
 }
 

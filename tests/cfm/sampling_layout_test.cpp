@@ -56,6 +56,8 @@ TEST(SamplingCounts, StacksMapToTheResolutionWithTheClosestCount) {
   EXPECT_EQ(clod::samplingResolutionForStacks(SamplingScheme::kHealpix, 10), 2);
   EXPECT_EQ(clod::samplingResolutionForStacks(SamplingScheme::kPolar, 10), 10);
   EXPECT_EQ(clod::samplingResolutionForStacks(SamplingScheme::kAdaptivePolar, 7), 7);
+  EXPECT_EQ(clod::samplingResolutionForStacks(SamplingScheme::kFibonacci, 10), 65);
+  EXPECT_EQ(clod::samplingResolutionForStacks(SamplingScheme::kFibonacci, 16), 163);
   for (int stacks : {1, 2, 5, 16, 20, 40}) {
     const auto target = static_cast<long>(clod::samplingSampleCount(SamplingScheme::kAdaptivePolar, stacks));
     for (SamplingScheme scheme : {SamplingScheme::kGeodesic, SamplingScheme::kHealpix}) {
@@ -115,6 +117,20 @@ TEST(SamplingSchemes, HealpixRingsSplitTheSphereIntoEqualAreaPixels) {
       const double z = s.direction(s.ringOffset(k)).z();
       const double capArea = 2.0 * M_PI * (1.0 - z);
       EXPECT_NEAR(capArea / pixelArea, s.ringOffset(k) + 0.5 * s.ringSize(k), 1e-9) << "N " << nside << " ring " << k;
+    }
+  }
+}
+
+TEST(SamplingSchemes, FibonacciSamplesEachOwnAnEqualAreaBand) {
+  // Archimedes: the area of a zone of the unit sphere is 2 pi times its height, so the points at
+  // z_i = 1 - (2i+1)/n sit in the middle (by area) of n bands of area 4 pi / n each.
+  for (int n : {1, 2, 7, 65, 1000}) {
+    const SphereSampling s = SphereSampling::build(SamplingScheme::kFibonacci, n);
+    ASSERT_EQ(s.size(), static_cast<std::uint32_t>(n));
+    const double bandArea = 4.0 * M_PI / n;
+    for (std::uint32_t i = 0; i < s.size(); ++i) {
+      const double capArea = 2.0 * M_PI * (1.0 - s.direction(i).z());
+      EXPECT_NEAR(capArea / bandArea, i + 0.5, 1e-9) << "n " << n << " #" << i;
     }
   }
 }

@@ -77,6 +77,7 @@ std::vector<Case> allCases() {
   for (int r : {1, 2, 4, 5, 10, 16, 20, 33}) cases.push_back({SamplingScheme::kAdaptivePolar, r});
   for (int r : {1, 2, 3, 5, 8, 16}) cases.push_back({SamplingScheme::kGeodesic, r});
   for (int r : {1, 2, 3, 4, 8, 16}) cases.push_back({SamplingScheme::kHealpix, r});
+  for (int r : {1, 2, 12, 65, 163, 1000, 4000}) cases.push_back({SamplingScheme::kFibonacci, r});
   return cases;
 }
 

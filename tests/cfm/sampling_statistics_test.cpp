@@ -40,9 +40,10 @@ TEST(SamplingStatistics, TwoStackFullPolarCountsCoincidentPoleSamples) {
 TEST(SamplingStatistics, Table2ShowsThePapersTrends) {
   // The paper's claims for Table 2 (section 7): adaptive polar has a smaller spread than full
   // polar at every stack count, both fall as stacks grow, and the adaptive advantage shrinks
-  // with more stacks. Beyond the paper: geodesic and HEALPix at matched counts beat adaptive polar.
+  // with more stacks. Beyond the paper: geodesic, HEALPix and Fibonacci at matched counts beat
+  // adaptive polar.
   const auto rows = clod::computeSamplingTable2(NeighbourDefinition::kNearest4);
-  ASSERT_EQ(rows.size(), 12u);
+  ASSERT_EQ(rows.size(), 15u);  // 5 schemes x 3 stack counts
   std::map<std::pair<int, SamplingScheme>, double> sd;
   for (const auto& row : rows) {
     sd[std::make_pair(row.stacks, row.scheme)] = row.stats.stdDev;
@@ -59,6 +60,7 @@ TEST(SamplingStatistics, Table2ShowsThePapersTrends) {
     previousRatio = adaptive / full;
     EXPECT_LT(at(stacks, SamplingScheme::kGeodesic), adaptive) << stacks;
     EXPECT_LT(at(stacks, SamplingScheme::kHealpix), adaptive) << stacks;
+    EXPECT_LT(at(stacks, SamplingScheme::kFibonacci), adaptive) << stacks;
   }
   EXPECT_LT(at(20, SamplingScheme::kPolar), at(10, SamplingScheme::kPolar));
   EXPECT_LT(at(10, SamplingScheme::kPolar), at(5, SamplingScheme::kPolar));

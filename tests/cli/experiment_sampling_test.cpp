@@ -56,7 +56,7 @@ TEST(ExperimentSamplingCli, JsonHasTable2RowsWithThePapersFiguresAndTable1Counts
   ASSERT_EQ(run.exitCode, 0) << run.err;
   const auto doc = nlohmann::json::parse(run.out);
   ASSERT_TRUE(doc.contains("rows"));
-  ASSERT_EQ(doc["rows"].size(), 12u);  // 4 schemes x 5, 10, 20 stacks
+  ASSERT_EQ(doc["rows"].size(), 15u);  // 5 schemes x 5, 10, 20 stacks
   int withPaper = 0;
   for (const auto& row : doc["rows"]) {
     for (const char* key : {"scheme", "stacks", "samples", "std_dev", "paper_std_dev", "neighbour_definition"}) {
@@ -122,7 +122,7 @@ TEST(ExperimentSamplingCli, OutputDirectoryGetsTheSameJsonAndACsv) {
   EXPECT_EQ(nlohmann::json::parse(readFile(outDir / "sampling.json")), nlohmann::json::parse(run.out));
   const std::string csv = readFile(outDir / "sampling.csv");
   EXPECT_EQ(csv.rfind("scheme,stacks,", 0), 0u);
-  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 13);  // header + 12 rows
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 16);  // header + 15 rows
   // No temporary files left behind by the atomic writes.
   int files = 0;
   for ([[maybe_unused]] const auto& entry : fs::directory_iterator(outDir)) ++files;
