@@ -85,11 +85,11 @@ void Builder::processCell(const PendingCell& cell, std::uint32_t depth, CellResu
     minAbs = std::min(minAbs, std::abs(cell.corners[c]));
     sameSign = sameSign && ((cell.corners[c] < 0.0f) == (cell.corners[0] < 0.0f));
   }
-  // Lipschitz: every point x of the cell is within one diagonal of every corner, so
-  // |d(x)| >= |d(corner)| - diagonal. If all corners exceed band + diagonal, no point of the
-  // cell is in the band and the surface does not cross it. The relative slack covers the
-  // float rounding of the corner values.
-  if (sameSign && double(minAbs) * (1.0 - 1e-6) > band + diagonal) {
+  // Lipschitz: every point x of the cell is within half a diagonal of its nearest corner c, so
+  // |d(x)| >= |d(c)| - diagonal/2. If all corners exceed band + diagonal/2 (same sign), no
+  // point of the cell is in the band and the surface does not cross it. The relative slack
+  // covers the float rounding of the corner values.
+  if (sameSign && double(minAbs) * (1.0 - 1e-6) > band + 0.5 * diagonal) {
     // Rigorous for any 1-Lipschitz field: |d(x) - sum w_i d(c_i)| <= sum w_i |x - c_i| <=
     // sqrt(sum w_i |x - c_i|^2) = h sqrt(sum_axes t(1-t)) <= h sqrt(3)/2.
     r.error = static_cast<float>(0.5 * diagonal);
@@ -132,10 +132,6 @@ void Builder::processCell(const PendingCell& cell, std::uint32_t depth, CellResu
       exact[l] = exactAt(0.5 * Vec3(i, j, k));
     }
   }
-  double octantCentre[8];
-  for (int o = 0; o < 8; ++o)
-    octantCentre[o] = exactAt(Vec3(0.25 + 0.5 * (o & 1), 0.25 + 0.5 * ((o >> 1) & 1), 0.25 + 0.5 * ((o >> 2) & 1)));
-
   // Interpolation error at the test points, overall and restricted to the band. A band point
   // is within 0.28 h of a test point (covering radius of this body-centred lattice), so a
   // test point counts for the band if |d| <= band + h/2.
@@ -148,8 +144,14 @@ void Builder::processCell(const PendingCell& cell, std::uint32_t depth, CellResu
   };
   for (int l = 0; l < kLatticeSize; ++l)
     if (kLatticeSlot[l] >= 0) account(0.5 * Vec3(l % 3, (l / 3) % 3, l / 9), exact[l]);
-  for (int o = 0; o < 8; ++o)
-    account(Vec3(0.25 + 0.5 * (o & 1), 0.25 + 0.5 * ((o >> 1) & 1), 0.25 + 0.5 * ((o >> 2) & 1)), octantCentre[o]);
+  // The octant centres only matter when the lattice alone does not already demand a split
+  // (they become the children's centres and are measured there anyway).
+  if (!(kGapFactor * bandError > tree_.errorAbs && depth < settings_.maxDepth)) {
+    for (int o = 0; o < 8; ++o) {
+      const Vec3 t(0.25 + 0.5 * (o & 1), 0.25 + 0.5 * ((o >> 1) & 1), 0.25 + 0.5 * ((o >> 2) & 1));
+      account(t, exactAt(t));
+    }
+  }
 
   // A distance is 1-Lipschitz; lattice neighbours (h/2 apart) differing by more reveal a sign
   // discontinuity (winding-number membrane over a hole, or a sign tie) that no refinement fixes.
