@@ -102,19 +102,20 @@ void Builder::processCell(const PendingCell& cell, std::uint32_t depth, CellResu
   // of an exact query for open meshes (a winding number), and often it is already known: if a
   // corner value v has |v| > |x - corner|, d(x) has v's sign, since |d(x) - v| <= |x - corner|.
   // Then only the unsigned distance is needed.
-  auto exactAt = [&](const Vec3& t) {
+  auto exactQuery = [&](const Vec3& t) -> MeshDistance::Signed {
     const Vec3 p = cellMin + h * t;
     ++r.queries;
     for (int c = 0; c < 8; ++c) {
       const double reach = h * (t - Vec3(c & 1, (c >> 1) & 1, (c >> 2) & 1)).norm();
       const double v = cell.corners[c];
       if (std::abs(v) * (1.0 - 1e-6) > reach + 1e-9 * h) {
-        const double unsignedDistance = distance_.closestPoint(p).distance;
-        return v < 0.0 ? -unsignedDistance : unsignedDistance;
+        const ClosestPoint closest = distance_.closestPoint(p);
+        return {closest, v < 0.0 ? -closest.distance : closest.distance};
       }
     }
-    return distance_.signedDistance(p);
+    return distance_.signedQuery(p);
   };
+  auto exactAt = [&](const Vec3& t) { return exactQuery(t).signedDistance; };
   double exact[kLatticeSize];
   MeshDistance::Signed centre{};
   for (int l = 0; l < kLatticeSize; ++l) {
@@ -125,9 +126,8 @@ void Builder::processCell(const PendingCell& cell, std::uint32_t depth, CellResu
       continue;
     }
     if (l == 13) {
-      centre = distance_.signedQuery(cellMin + 0.5 * h * Vec3(i, j, k));
+      centre = exactQuery(0.5 * Vec3(i, j, k));
       exact[l] = centre.signedDistance;
-      ++r.queries;
     } else {
       exact[l] = exactAt(0.5 * Vec3(i, j, k));
     }
