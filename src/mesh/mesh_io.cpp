@@ -23,12 +23,15 @@ namespace clod {
 
 namespace {
 
-// Only triangulation. Deliberately absent: JoinIdenticalVertices (we weld with a tolerance),
+// Post-processing: only triangulation, applied after checkRawScene (below) has looked at the
+// importer's output, because the packaged Assimp is built with its internal asserts enabled and
+// aborts the process when triangulating a face without indices (fuzz_mesh_load found an OFF
+// file that produces one). Deliberately absent: JoinIdenticalVertices (we weld with a tolerance),
 // FindDegenerates / FindInvalidData (they drop or alter triangles, hiding the counts we report),
 // FixInfacingNormals (it guesses; we orient by signed volume), ValidateDataStructure (its
 // findings arrive as log lines; we check ourselves), PreTransformVertices (we apply node
 // transforms ourselves, instancing meshes referenced by several nodes).
-constexpr unsigned kImportFlags = aiProcess_Triangulate;
+constexpr unsigned kPostProcessFlags = aiProcess_Triangulate;
 
 // Some Assimp importers repair bad data and only log it (the OFF reader clamps an out-of-range
 // index to the last vertex; the glTF reader drops faces with out-of-range indices). So every
@@ -80,6 +83,36 @@ const aiScene* importCapturingLog(Assimp::Importer& importer, CapturedLog& log, 
   return scene;
 }
 
+// What Assimp's post-processing assumes of a scene, checked before it runs: vertex and face
+// arrays present, every face with at least one index, every index in range.
+void checkRawScene(const aiScene* scene, const std::string& source) {
+  if (scene->mNumMeshes > 0 && !scene->mMeshes) throw Error(ErrorCode::kParseError, source + ": mesh list missing");
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* mesh = scene->mMeshes[m];
+    const std::string where = source + ": mesh " + std::to_string(m);
+    if (!mesh) throw Error(ErrorCode::kParseError, where + " missing");
+    if (mesh->mNumVertices > 0 && !mesh->mVertices) throw Error(ErrorCode::kParseError, where + ": no vertex positions");
+    if (mesh->mNumFaces > 0 && !mesh->mFaces) throw Error(ErrorCode::kParseError, where + ": no faces");
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const aiFace& face = mesh->mFaces[f];
+      if (face.mNumIndices == 0 || !face.mIndices)
+        throw Error(ErrorCode::kParseError, where + ", face " + std::to_string(f) + ": no vertex indices");
+      for (unsigned k = 0; k < face.mNumIndices; ++k)
+        if (face.mIndices[k] >= mesh->mNumVertices)
+          throw Error(ErrorCode::kIndexOutOfRange, where + ", face " + std::to_string(f) + ": vertex index " +
+                                                       std::to_string(face.mIndices[k]) + " >= vertex count " +
+                                                       std::to_string(mesh->mNumVertices));
+    }
+  }
+}
+
+// Import without post-processing, check, then triangulate (see kPostProcessFlags).
+const aiScene* importChecked(Assimp::Importer& importer, const aiScene* raw, const std::string& source) {
+  if (!raw) return nullptr;
+  checkRawScene(raw, source);
+  return importer.ApplyPostProcessing(kPostProcessFlags);
+}
+
 bool mentionsIndexOutOfRange(const std::string& message) {
   return message.find("out of range") != std::string::npos || message.find("out-of-range") != std::string::npos;
 }
@@ -94,7 +127,8 @@ bool mentionsIndexOutOfRange(const std::string& message) {
   if (mentionsIndexOutOfRange(message)) {
     std::optional<std::string> where;
     if (format == "obj") where = detail::findBadObjIndex(text);
-    if (format == "off") where = detail::findBadOffIndex(text);
+    if (format == "off")
+      if (auto bad = detail::findBadOffFace(text)) where = bad->message;
     throw Error(ErrorCode::kIndexOutOfRange, source + ": " + (where ? *where : message));
   }
   throw Error(ErrorCode::kParseError, source + ": " + (message.empty() ? std::string("import failed") : message));
@@ -234,6 +268,14 @@ LoadedMesh convertScene(const aiScene* scene, const CapturedLog& log, const std:
   return result;
 }
 
+// The checks Assimp needs before it sees the bytes (see text_index_check.h).
+void checkText(std::string_view text, std::string_view format, const std::string& source) {
+  if (auto problem = detail::findPlyHeaderProblem(text)) throw Error(ErrorCode::kParseError, source + ": " + *problem);
+  if (format == "off")
+    if (auto bad = detail::findBadOffFace(text))
+      throw Error(bad->indexOutOfRange ? ErrorCode::kIndexOutOfRange : ErrorCode::kParseError, source + ": " + bad->message);
+}
+
 void checkOptions(const MeshLoadOptions& options) {
   if (std::isnan(options.weldToleranceRel)) throw Error(ErrorCode::kInvalidArgument, "weldToleranceRel is NaN");
 }
@@ -259,17 +301,26 @@ LoadedMesh loadMesh(const std::filesystem::path& path, const MeshLoadOptions& op
   }
   std::string format = lowercase(path.extension().string());
   if (!format.empty()) format.erase(0, 1);
-  // The text of OBJ and OFF files is needed for the index checks (see text_index_check.h).
+  // The text of OBJ, OFF and PLY files is needed for the checks of text_index_check.h. Assimp
+  // sniffs PLY content whatever the extension, so every file's first bytes are looked at.
   std::string text;
-  if (format == "obj" || format == "off") text = readWholeFile(path);
-  if (format == "off")
-    if (auto bad = detail::findBadOffIndex(text)) throw Error(ErrorCode::kIndexOutOfRange, source + ": " + *bad);
+  if (format == "obj" || format == "off" || format == "ply") {
+    text = readWholeFile(path);
+  } else {
+    char head[64] = {};
+    if (std::FILE* file = std::fopen(path.c_str(), "rb")) {
+      const std::size_t n = std::fread(head, 1, sizeof head, file);
+      std::fclose(file);
+      if (detail::looksLikePly(std::string_view(head, n))) text = readWholeFile(path);
+    }
+  }
+  checkText(text, format, source);
 
   Assimp::Importer importer;
   CapturedLog log;
   // Through ReadFile, not from memory, so that a .gltf finds its external .bin next to it.
   const aiScene* scene = importCapturingLog(importer, log, [&](Assimp::Importer& imp) {
-    return imp.ReadFile(path.string(), kImportFlags);
+    return importChecked(imp, imp.ReadFile(path.string(), 0), source);
   });
   if (!scene) throwImportError(source, importer.GetErrorString(), format, text);
   return convertScene(scene, log, source, options);
@@ -287,13 +338,12 @@ LoadedMesh loadMeshFromMemory(std::span<const std::byte> bytes, std::string_view
   const std::string source = "<memory:" + format + ">";
   if (bytes.empty()) throw Error(ErrorCode::kEmptyFile, source + " is empty (0 bytes)");
   const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-  if (format == "off")
-    if (auto bad = detail::findBadOffIndex(text)) throw Error(ErrorCode::kIndexOutOfRange, source + ": " + *bad);
+  checkText(text, format, source);
 
   Assimp::Importer importer;
   CapturedLog log;
   const aiScene* scene = importCapturingLog(importer, log, [&](Assimp::Importer& imp) {
-    return imp.ReadFileFromMemory(bytes.data(), bytes.size(), kImportFlags, format.c_str());
+    return importChecked(imp, imp.ReadFileFromMemory(bytes.data(), bytes.size(), 0, format.c_str()), source);
   });
   if (!scene) throwImportError(source, importer.GetErrorString(), format, text);
   return convertScene(scene, log, source, options);

@@ -43,10 +43,10 @@ std::optional<long long> parseInteger(std::string_view token) {
 
 }  // namespace
 
-std::optional<std::string> findBadOffIndex(std::string_view text) {
+std::optional<OffProblem> findBadOffFace(std::string_view text) {
   enum class Stage { kHeader, kCounts, kVertices, kFaces, kDone } stage = Stage::kHeader;
   long long vertexCount = 0, faceCount = 0, verticesSeen = 0, facesSeen = 0;
-  std::optional<std::string> result;
+  std::optional<OffProblem> result;
   forEachTokenLine(text, [&](std::size_t line, const std::vector<std::string_view>& tokens) {
     std::size_t first = 0;
     if (stage == Stage::kHeader) {
@@ -79,13 +79,19 @@ std::optional<std::string> findBadOffIndex(std::string_view text) {
     }
     // Stage::kFaces
     auto n = parseInteger(tokens[0]);
-    if (!n || *n < 0 || tokens.size() < std::size_t(*n) + 1) return false;
+    if (n && *n <= 0) {
+      result = OffProblem{false, "line " + std::to_string(line) + ": face " + std::to_string(facesSeen) + " lists " +
+                                     std::to_string(*n) + " vertices"};
+      return false;
+    }
+    if (!n || tokens.size() < std::size_t(*n) + 1) return false;
     for (long long k = 1; k <= *n; ++k) {
       auto index = parseInteger(tokens[std::size_t(k)]);
       if (!index) return false;
       if (*index < 0 || *index >= vertexCount) {
-        result = "line " + std::to_string(line) + ": face " + std::to_string(facesSeen) + ": vertex index " +
-                 std::to_string(*index) + (*index < 0 ? " is negative" : " >= vertex count " + std::to_string(vertexCount));
+        result = OffProblem{true, "line " + std::to_string(line) + ": face " + std::to_string(facesSeen) +
+                                      ": vertex index " + std::to_string(*index) +
+                                      (*index < 0 ? " is negative" : " >= vertex count " + std::to_string(vertexCount))};
         return false;
       }
     }
@@ -121,6 +127,28 @@ std::optional<std::string> findBadObjIndex(std::string_view text) {
     return true;
   });
   return result;
+}
+
+bool looksLikePly(std::string_view text) {
+  std::size_t i = 0;
+  while (i < text.size() && (text[i] == ' ' || text[i] == '\t' || text[i] == '\r' || text[i] == '\n')) ++i;
+  if (text.size() - i < 3) return false;
+  auto lower = [](char c) { return c >= 'A' && c <= 'Z' ? char(c - 'A' + 'a') : c; };
+  return lower(text[i]) == 'p' && lower(text[i + 1]) == 'l' && lower(text[i + 2]) == 'y';
+}
+
+std::optional<std::string> findPlyHeaderProblem(std::string_view text) {
+  if (!looksLikePly(text)) return std::nullopt;
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    std::size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(pos, end - pos);
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.remove_suffix(1);
+    if (line == "end_header") return std::nullopt;
+    pos = end + 1;
+  }
+  return "PLY header has no 'end_header' line";
 }
 
 }  // namespace clod::detail

@@ -185,6 +185,13 @@ TEST(LoadMesh, EveryBadFileGivesItsErrorCodeAndNamesTheCulprit) {
       {"all_degenerate.obj", ErrorCode::kAllTrianglesDegenerate, "all 3 triangles have zero area"},
       {"truncated_binary.stl", ErrorCode::kParseError, "STL"},
       {"malformed.off", ErrorCode::kParseError, "zero"},
+      // Assimp 5.2.5's PLY reader never returns on this (found by fuzz_mesh_load).
+      {"ply_no_end_header.ply", ErrorCode::kParseError, "end_header"},
+      // Assimp's OFF reader makes a face without indices; triangulating it trips an Assimp
+      // assert that aborts the process (found by fuzz_mesh_load).
+      {"face_without_indices.off", ErrorCode::kParseError, "face 0: no vertex indices"},
+      // Assimp's OFF reader reads out of bounds on a face of 0 vertices (found by fuzz_mesh_load).
+      {"face_with_zero_vertices.off", ErrorCode::kParseError, "line 6: face 0 lists 0 vertices"},
   };
   for (const BadCase& c : cases) {
     SCOPED_TRACE(c.file);
@@ -192,6 +199,17 @@ TEST(LoadMesh, EveryBadFileGivesItsErrorCodeAndNamesTheCulprit) {
     EXPECT_EQ(thrown.code, c.code) << errorCodeName(thrown.code) << ": " << thrown.message;
     EXPECT_NE(thrown.message.find(c.file), std::string::npos) << thrown.message;
     EXPECT_NE(thrown.message.find(c.culprit), std::string::npos) << thrown.message;
+  }
+}
+
+TEST(LoadMesh, PlyContentIsCheckedWhateverTheExtension) {
+  // Assimp sniffs PLY content in files with unknown extensions; the guard must follow it.
+  const std::string ply = readBytes(badFile("ply_no_end_header.ply"));
+  for (const char* hint : {"ply", "xyz", "obj"}) {
+    SCOPED_TRACE(hint);
+    const Thrown thrown = thrownBy([&] { loadMeshFromMemory(asBytes(ply), hint); });
+    EXPECT_EQ(thrown.code, ErrorCode::kParseError);
+    EXPECT_NE(thrown.message.find("end_header"), std::string::npos) << thrown.message;
   }
 }
 
