@@ -15,13 +15,19 @@ namespace clod::detail {
 namespace {
 
 // How far a piece's clustering point moves from the surface towards its inner pole
-// (0 = surface point, 1 = pole). Halfway groups opposite sides of thin parts while pieces on a
-// round blob still spread out enough to cluster.
-constexpr double kPolePull = 0.5;
+// (0 = surface point, 1 = pole), by the level being split. Near the root, pulling far groups
+// whole limbs and both sides of thin parts into one sphere; deeper down the poles are far
+// compared to the nodes, and a small pull keeps clusters compact on the surface. Chosen by
+// measuring the fit on the shared closed meshes (docs/benchmarks/sphere_tree.md).
+double polePull(std::uint32_t level) {
+  constexpr double kPull[] = {0.5, 0.25, 0.15};
+  return kPull[std::min<std::uint32_t>(level, 2)];
+}
 // Pieces larger than this fraction of their node's diagonal are split before clustering.
 constexpr double kMaxPieceFraction = 0.2;
 constexpr int kLloydIterations = 12;
 constexpr int kFitDirections = 32;
+constexpr std::uint32_t kClusteringRestarts = 4;
 
 struct Context {
   const TriangleMesh* mesh = nullptr;
@@ -31,14 +37,14 @@ struct Context {
   std::uint32_t branching = 8;
   std::uint32_t seed = 1;
 
-  void setFeature(SurfacePiece& piece) const {
+  void setPoleOffset(SurfacePiece& piece) const {
     const Vec3 c = piece.centroid();
     if (samples.size() == 0) {
-      piece.feature = c;
+      piece.poleOffset = Vec3::Zero();
       return;
     }
     const std::uint32_t s = grid->nearest(c);
-    piece.feature = c + kPolePull * (samples.poleCenter[s] - samples.position[s]);
+    piece.poleOffset = samples.poleCenter[s] - samples.position[s];
   }
 };
 
@@ -72,8 +78,8 @@ void refinePieces(const Context& ctx, std::vector<SurfacePiece>& pieces) {
       out.push_back(piece);
       return false;
     }
-    ctx.setFeature(below);
-    ctx.setFeature(above);
+    ctx.setPoleOffset(below);
+    ctx.setPoleOffset(above);
     out.push_back(below);
     out.push_back(above);
     return true;
@@ -110,7 +116,8 @@ void refinePieces(const Context& ctx, std::vector<SurfacePiece>& pieces) {
 
 // Weighted k-means (k-means++ seeding) of the pieces' clustering points. Returns a cluster id per
 // piece; ids are in [0, k).
-std::vector<std::uint32_t> clusterPieces(const std::vector<SurfacePiece>& pieces, std::uint32_t k, std::uint32_t seed) {
+std::vector<std::uint32_t> clusterPieces(const std::vector<SurfacePiece>& pieces, const std::vector<Vec3>& feature,
+                                         std::uint32_t k, std::uint32_t seed) {
   const std::size_t n = pieces.size();
   std::vector<std::uint32_t> label(n, 0);
   if (k <= 1) return label;
@@ -123,12 +130,12 @@ std::vector<std::uint32_t> clusterPieces(const std::vector<SurfacePiece>& pieces
   for (std::size_t i = 0; i < n; ++i) weight[i] = std::max(pieces[i].area, minPositive);
 
   std::vector<Vec3> centers;
-  centers.push_back(pieces[std::uniform_int_distribution<std::size_t>(0, n - 1)(rng)].feature);
+  centers.push_back(feature[std::uniform_int_distribution<std::size_t>(0, n - 1)(rng)]);
   std::vector<double> d2(n, std::numeric_limits<double>::infinity());
   while (centers.size() < k) {
     double total = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
-      d2[i] = std::min(d2[i], (pieces[i].feature - centers.back()).squaredNorm());
+      d2[i] = std::min(d2[i], (feature[i] - centers.back()).squaredNorm());
       total += weight[i] * d2[i];
     }
     if (!(total > 0.0)) break;  // fewer distinct points than k
@@ -141,7 +148,7 @@ std::vector<std::uint32_t> clusterPieces(const std::vector<SurfacePiece>& pieces
         break;
       }
     }
-    centers.push_back(pieces[chosen].feature);
+    centers.push_back(feature[chosen]);
   }
   const std::size_t kk = centers.size();
   std::vector<Vec3> sum(kk);
@@ -152,7 +159,7 @@ std::vector<std::uint32_t> clusterPieces(const std::vector<SurfacePiece>& pieces
       std::uint32_t best = 0;
       double bestD = std::numeric_limits<double>::infinity();
       for (std::size_t c = 0; c < kk; ++c) {
-        const double d = (pieces[i].feature - centers[c]).squaredNorm();
+        const double d = (feature[i] - centers[c]).squaredNorm();
         if (d < bestD) {
           bestD = d;
           best = static_cast<std::uint32_t>(c);
@@ -165,13 +172,51 @@ std::vector<std::uint32_t> clusterPieces(const std::vector<SurfacePiece>& pieces
     std::fill(sum.begin(), sum.end(), Vec3::Zero());
     std::fill(mass.begin(), mass.end(), 0.0);
     for (std::size_t i = 0; i < n; ++i) {
-      sum[label[i]] += weight[i] * pieces[i].feature;
+      sum[label[i]] += weight[i] * feature[i];
       mass[label[i]] += weight[i];
     }
-    for (std::size_t c = 0; c < kk; ++c)
-      if (mass[c] > 0.0) centers[c] = sum[c] / mass[c];
+    for (std::size_t c = 0; c < kk; ++c) {
+      if (mass[c] > 0.0) {
+        centers[c] = sum[c] / mass[c];
+        continue;
+      }
+      // An empty cluster restarts at the piece farthest from its own centre, so nodes keep
+      // `branching` children whenever there are enough distinct pieces.
+      std::size_t farthest = 0;
+      double farthestD = -1.0;
+      for (std::size_t i = 0; i < n; ++i) {
+        const double d = (feature[i] - centers[label[i]]).squaredNorm();
+        if (d > farthestD) {
+          farthestD = d;
+          farthest = i;
+        }
+      }
+      centers[c] = feature[farthest];
+      label[farthest] = static_cast<std::uint32_t>(c);
+      changed = true;
+    }
   }
   return label;
+}
+
+// Score of a clustering: largest plus mean radius of the clusters' smallest enclosing spheres.
+// The radius bounds a sphere's overshoot, so this steers the restarts towards a low worst fit
+// without running the (costlier) fit estimate for every restart.
+double clusteringScore(const std::vector<SurfacePiece>& pieces, const std::vector<std::uint32_t>& label,
+                       std::uint32_t k, std::vector<Vec3>& scratch) {
+  std::vector<std::vector<Vec3>> corners(k);
+  for (std::size_t i = 0; i < pieces.size(); ++i)
+    corners[label[i]].insert(corners[label[i]].end(), pieces[i].points().begin(), pieces[i].points().end());
+  double largest = 0.0, sum = 0.0;
+  std::uint32_t used = 0;
+  for (const auto& points : corners) {
+    if (points.empty()) continue;
+    const double r = minimumEnclosingSphere(points, scratch).radius;
+    largest = std::max(largest, r);
+    sum += r;
+    ++used;
+  }
+  return largest + (used > 0 ? sum / used : 0.0);
 }
 
 // Estimated fit of a sphere: the largest distance from points on its surface to the nearest of
@@ -199,21 +244,24 @@ Sphere chooseSphere(const Context& ctx, const std::vector<SurfacePiece>& pieces,
     surfacePoints.insert(surfacePoints.end(), p.points().begin(), p.points().end());
     surfacePoints.push_back(p.centroid());
     const double w = std::max(p.area, 1e-300);
-    // The clustering point lies kPolePull of the way to the pole: extrapolate to the pole.
-    medial += w * (p.centroid() + (p.feature - p.centroid()) / kPolePull);
+    medial += w * (p.centroid() + p.poleOffset);
     mass += w;
   }
   const Sphere smallest = minimumEnclosingSphere(corners, scratch);
   if (pieces.size() == 1) return smallest;
   medial /= mass;
-  Sphere candidates[3];
-  candidates[0] = smallest;
-  candidates[1].center = medial;
-  candidates[2].center = 0.5 * (medial + smallest.center);
-  for (int i = 1; i < 3; ++i) candidates[i].radius = farthestDistance(candidates[i].center, corners);
+  // Candidates on the segment from the smallest enclosing sphere's centre to the cluster's
+  // medial centre, each expanded to cover the cluster; keep the one of lowest estimated fit.
+  constexpr int kCandidates = 5;
+  Sphere candidates[kCandidates];
+  for (int i = 0; i < kCandidates; ++i) {
+    const double t = static_cast<double>(i) / (kCandidates - 1);
+    candidates[i].center = (1.0 - t) * smallest.center + t * medial;
+    candidates[i].radius = i == 0 ? smallest.radius : farthestDistance(candidates[i].center, corners);
+  }
   int best = 0;
   double bestFit = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < 3; ++i) {
+  for (int i = 0; i < kCandidates; ++i) {
     const double fit = estimateFit(candidates[i], ctx.directions, surfacePoints);
     if (fit < bestFit) {
       bestFit = fit;
@@ -242,7 +290,7 @@ SphereTree buildMedialSphereTree(const TriangleMesh& mesh, const SphereTreeSetti
   root.pieces.resize(mesh.triangleCount());
   tbb::parallel_for(std::uint32_t{0}, mesh.triangleCount(), [&](std::uint32_t t) {
     root.pieces[t] = makeTrianglePiece(mesh, t);
-    ctx.setFeature(root.pieces[t]);
+    ctx.setPoleOffset(root.pieces[t]);
   });
   std::vector<Vec3> scratch;
   root.sphere = minimumEnclosingSphere(mesh.vertices, scratch);
@@ -252,7 +300,23 @@ SphereTree buildMedialSphereTree(const TriangleMesh& mesh, const SphereTreeSetti
     std::vector<SurfacePiece> pieces = parent.pieces;
     refinePieces(ctx, pieces);
     const std::uint32_t k = static_cast<std::uint32_t>(std::min<std::size_t>(ctx.branching, pieces.size()));
-    const std::vector<std::uint32_t> label = clusterPieces(pieces, k, ctx.seed * 0x9e3779b9u + level * 7919u + index);
+    // k-means from a few seedings; keep the one whose clusters have the smallest spheres.
+    std::vector<Vec3> feature(pieces.size());
+    const double pull = polePull(level);
+    for (std::size_t i = 0; i < pieces.size(); ++i) feature[i] = pieces[i].centroid() + pull * pieces[i].poleOffset;
+    std::vector<std::uint32_t> label;
+    double bestScore = std::numeric_limits<double>::infinity();
+    std::vector<Vec3> scoreScratch;
+    for (std::uint32_t restart = 0; restart < kClusteringRestarts; ++restart) {
+      std::vector<std::uint32_t> candidate =
+          clusterPieces(pieces, feature, k, ctx.seed * 0x9e3779b9u + level * 7919u + index * 31u + restart);
+      const double score = k > 1 ? clusteringScore(pieces, candidate, k, scoreScratch) : 0.0;
+      if (score < bestScore) {
+        bestScore = score;
+        label = std::move(candidate);
+      }
+      if (k <= 1) break;
+    }
     std::vector<BuildNode> clusters(k);
     for (std::size_t i = 0; i < pieces.size(); ++i) clusters[label[i]].pieces.push_back(pieces[i]);
     std::vector<Vec3> corners, scratchPoints, surfacePoints;

@@ -22,7 +22,6 @@ SurfacePiece makeTrianglePiece(const TriangleMesh& mesh, std::uint32_t t) {
   piece.cornerCount = 3;
   piece.triangle = t;
   piece.area = mesh.triangleArea(t);
-  piece.feature = piece.centroid();
   return piece;
 }
 
@@ -37,7 +36,7 @@ double polygonArea(std::span<const Vec3> corners) {
 SurfacePiece clipPiece(const SurfacePiece& piece, int axis, double value, bool keepBelow) {
   SurfacePiece out;
   out.triangle = piece.triangle;
-  out.feature = piece.feature;
+  out.poleOffset = piece.poleOffset;
   const int n = piece.cornerCount;
   auto inside = [&](const Vec3& p) { return keepBelow ? p[axis] <= value : p[axis] >= value; };
   bool allInside = true;

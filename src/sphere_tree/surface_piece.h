@@ -21,8 +21,9 @@ struct SurfacePiece {
   std::uint8_t cornerCount = 0;
   std::uint32_t triangle = 0;
   double area = 0.0;
-  /// Where the medial builder clusters this piece (unused by the octree builder).
-  Vec3 feature = Vec3::Zero();
+  /// Medial builder: vector from the piece towards the inner medial pole nearest to it
+  /// (unused by the octree builder).
+  Vec3 poleOffset = Vec3::Zero();
 
   std::span<const Vec3> points() const { return {corners.data(), cornerCount}; }
   Vec3 centroid() const;
