@@ -1,0 +1,82 @@
+#pragma once
+// A body's precomputed collision data, bundled for the narrow phase (query.h): the mesh, its
+// sphere-tree, and optionally its closest feature map (needed by the cfm and average models) and
+// its contact tree (needed by the contact-tree model). Everything is in the body's own (mesh)
+// coordinates; a query places two bodies in the world with a Pose each.
+//
+// Build once (from a bake file or from parts), then share: a CollisionBody is immutable after
+// construction and any number of threads may query it at once.
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "clod/closest_feature_map.h"
+#include "clod/contact_tree.h"
+#include "clod/mesh.h"
+#include "clod/sphere_tree.h"
+
+namespace clod {
+
+struct BakeContents;
+
+class CollisionBody {
+public:
+  /// A body from its mesh and the sphere-tree built for it. Checks that the tree fits the mesh
+  /// and throws clod::Error(kInvalidArgument) naming the culprit otherwise: an empty tree,
+  /// arrays of inconsistent length, a child range outside the next level, a triangle index >=
+  /// the mesh's triangle count. O(spheres + triangle references).
+  CollisionBody(TriangleMesh mesh, SphereTree tree);
+
+  /// Everything a bake holds (mesh, sphere-tree, and closest feature map and contact tree where
+  /// the bake has those sections). Same checks as above.
+  static CollisionBody fromBake(const BakeContents& bake);
+
+  /// Adds the closest feature map (built for this body's sphere-tree). Throws
+  /// clod::Error(kInvalidArgument) if its sphere or level count differs from the tree's.
+  void setClosestFeatureMap(ClosestFeatureMap map);
+  /// Adds the contact tree (built for this body's mesh). Throws clod::Error(kInvalidArgument)
+  /// if it has no nodes.
+  void setContactTree(ContactTree tree);
+
+  const TriangleMesh& mesh() const noexcept { return mesh_; }
+  const SphereTree& sphereTree() const noexcept { return tree_; }
+  bool hasClosestFeatureMap() const noexcept { return map_.has_value(); }
+  bool hasContactTree() const noexcept { return contactTree_.has_value(); }
+  /// Precondition (CLOD_ASSERT): hasClosestFeatureMap().
+  const ClosestFeatureMap& closestFeatureMap() const noexcept;
+  /// Precondition (CLOD_ASSERT): hasContactTree().
+  const ContactTree& contactTree() const noexcept;
+
+  /// Level of each sphere (0 = root), precomputed.
+  std::uint32_t sphereLevel(std::uint32_t sphere) const noexcept { return sphereLevel_[sphere]; }
+  /// The distinct face normals of the triangles sphere `sphere` is responsible for, when there
+  /// are at most kMaxSphereFaceNormals of them (a faceted patch: a box corner, a CAD part's
+  /// flat faces); empty otherwise (a curved patch). Normals closer than 1e-6 rad count as one.
+  /// The cfm model uses them to tell a face normal from an edge or vertex pseudonormal.
+  std::span<const Vec3f> sphereFaceNormals(std::uint32_t sphere) const noexcept {
+    return {faceNormals_.data() + faceNormalOffsets_[sphere], faceNormalOffsets_[sphere + 1] - faceNormalOffsets_[sphere]};
+  }
+  static constexpr std::uint32_t kMaxSphereFaceNormals = 8;
+
+  /// Bounding-box diagonal of the mesh: the unit of this body's relative tolerances.
+  double diagonal() const noexcept { return diagonal_; }
+  /// Where the body came from (a bake's source name), for messages; may be empty.
+  const std::string& name() const noexcept { return name_; }
+  void setName(std::string name) { name_ = std::move(name); }
+
+private:
+  TriangleMesh mesh_;
+  SphereTree tree_;
+  std::optional<ClosestFeatureMap> map_;
+  std::optional<ContactTree> contactTree_;
+  std::vector<std::uint32_t> sphereLevel_;
+  std::vector<std::uint32_t> faceNormalOffsets_;
+  std::vector<Vec3f> faceNormals_;
+  double diagonal_ = 0.0;
+  std::string name_;
+};
+
+}  // namespace clod

@@ -1,0 +1,86 @@
+#pragma once
+// Contacts between two rigid bodies A and B, as the narrow phase (query.h) returns them and the
+// dynamics consumes them, and the reduction of many raw contacts to a small manifold.
+//
+// Conventions (docs/conventions.md, the same everywhere in clod):
+//   * everything is in the world frame;
+//   * the contact normal is a unit vector pointing FROM BODY B TOWARD BODY A: pushing A along
+//     +normal (or B along -normal) separates them;
+//   * depth is positive when the bodies penetrate, in the bodies' length unit.
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "clod/math.h"
+
+namespace clod {
+
+/// How a query turns what its traversal reached into contacts (docs/narrow-phase.md).
+/// Values are stable: tools and files use them.
+enum class ContactModel : std::uint8_t {
+  /// Dingliana & O'Sullivan: for each overlapping sphere pair of the frontier, the point on the
+  /// centre line where the plane of the spheres' intersection circle cuts it, the normal along
+  /// the centre line (B's centre toward A's), depth r_A + r_B - |c_A - c_B|.
+  kDos = 0,
+  /// The straw man of Giang & O'Sullivan: D&O point and depth, normal from the area-weighted
+  /// average normals of the triangles each sphere bounds (ClosestFeatureMap::averageNormal),
+  /// combined as normalize(n_B - n_A) (falls back to D&O where that is undefined).
+  kAverage = 1,
+  /// Closest feature maps: D&O point and depth, each sphere's CFM normal for the direction of
+  /// the contact point from its centre, combined by the flatness rule of docs/narrow-phase.md.
+  kCfm = 2,
+  /// Contact trees (Kaufman et al. 2007): traversal of the two contact trees, then contact
+  /// sampling of the frontier cell pairs (contact_sampling.h), both ways round.
+  kContactTree = 3,
+  /// Polygon-level reference: triangle-triangle intersection of the leaves' triangles.
+  kExact = 4,
+};
+
+/// All models, in enum order.
+std::span<const ContactModel> allContactModels() noexcept;
+/// "dos", "average", "cfm", "contact-tree", "exact".
+std::string_view contactModelName(ContactModel model) noexcept;
+/// Inverse of contactModelName (exact, case-sensitive). Throws clod::Error(kInvalidArgument)
+/// naming the text and listing the valid names.
+ContactModel parseContactModel(std::string_view name);
+
+/// One contact point between A and B (world frame).
+struct Contact {
+  Vec3 point = Vec3::Zero();    ///< the contact point
+  Vec3 normal = Vec3::UnitZ();  ///< unit, from B toward A
+  double depth = 0.0;           ///< penetration, > 0 when penetrating
+  /// How far the answer may be off, in length units: for sphere models the sum of the two
+  /// spheres' radii (the surfaces are somewhere inside both spheres, so depth and point are
+  /// uncertain by up to that much; it shrinks by the branching factor per level); for the
+  /// contact tree the field's error bound; 0 for exact contacts.
+  double errorBound = 0.0;
+  /// Level of the pair the contact came from: for sphere-trees max(level of A's sphere, level
+  /// of B's sphere), 0 = the roots; for contact trees the deeper cell's depth.
+  std::uint32_t level = 0;
+};
+
+/// How reduceManifold picks contacts.
+struct ManifoldSettings {
+  /// At most this many contacts are kept, >= 1.
+  std::uint32_t maxContacts = 8;
+  /// Contacts closer than this (length units, >= 0) to an already kept one are merged into it
+  /// (dropped), so a face-on-face contact does not return many copies of one corner.
+  double mergeDistanceAbs = 0.0;
+};
+
+/// Reduces `contacts` to a manifold of at most settings.maxContacts well-spread contacts, in
+/// place: on return the kept contacts are contacts[0 .. n), where n is the return value.
+/// Rule: keep the deepest contact first; then repeatedly add the contact whose smallest
+/// distance to the kept ones, measured in the plane perpendicular to the deepest contact's
+/// normal (farthest-point sampling in the contact plane), is largest; stop at maxContacts or
+/// when that distance falls to mergeDistanceAbs or below. Ties are broken by input order, so
+/// the result depends only on the input sequence. `scratch` is reused (no allocation once it
+/// has grown to contacts.size()). O(n * maxContacts). Throws clod::Error(kInvalidArgument) if
+/// maxContacts == 0 or mergeDistanceAbs is negative or not finite.
+std::size_t reduceManifold(std::span<Contact> contacts, const ManifoldSettings& settings,
+                           std::vector<double>& scratch);
+
+}  // namespace clod

@@ -1,0 +1,81 @@
+#include "clod/contact.h"
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "clod/error.h"
+
+namespace clod {
+namespace {
+
+constexpr std::array<ContactModel, 5> kModels = {ContactModel::kDos, ContactModel::kAverage, ContactModel::kCfm,
+                                                 ContactModel::kContactTree, ContactModel::kExact};
+
+}  // namespace
+
+std::span<const ContactModel> allContactModels() noexcept { return kModels; }
+
+std::string_view contactModelName(ContactModel model) noexcept {
+  switch (model) {
+    case ContactModel::kDos: return "dos";
+    case ContactModel::kAverage: return "average";
+    case ContactModel::kCfm: return "cfm";
+    case ContactModel::kContactTree: return "contact-tree";
+    case ContactModel::kExact: return "exact";
+  }
+  return "unknown";
+}
+
+ContactModel parseContactModel(std::string_view name) {
+  for (ContactModel m : kModels) {
+    if (contactModelName(m) == name) return m;
+  }
+  throw Error(ErrorCode::kInvalidArgument,
+              "unknown contact model '" + std::string(name) + "' (valid: dos, average, cfm, contact-tree, exact)");
+}
+
+std::size_t reduceManifold(std::span<Contact> contacts, const ManifoldSettings& settings, std::vector<double>& scratch) {
+  if (settings.maxContacts == 0) throw Error(ErrorCode::kInvalidArgument, "manifold maxContacts must be >= 1");
+  if (!(settings.mergeDistanceAbs >= 0.0) || !std::isfinite(settings.mergeDistanceAbs)) {
+    throw Error(ErrorCode::kInvalidArgument, "manifold mergeDistanceAbs must be finite and >= 0");
+  }
+  const std::size_t n = contacts.size();
+  if (n == 0) return 0;
+
+  // Deepest first (first in input order among equals).
+  std::size_t deepest = 0;
+  for (std::size_t i = 1; i < n; ++i) {
+    if (contacts[i].depth > contacts[deepest].depth) deepest = i;
+  }
+  std::swap(contacts[0], contacts[deepest]);
+  // Distances are measured in the contact plane so that contacts stacked along the normal (the
+  // same spot seen at different depths) count as one, and spread means spread along the surface.
+  const Vec3 normal = contacts[0].normal;
+  auto planar = [&](const Vec3& d) { return (d - normal.dot(d) * normal).squaredNorm(); };
+
+  scratch.resize(n);
+  for (std::size_t i = 1; i < n; ++i) scratch[i] = planar(contacts[i].point - contacts[0].point);
+  const double mergeSquared = settings.mergeDistanceAbs * settings.mergeDistanceAbs;
+  std::size_t kept = 1;
+  while (kept < settings.maxContacts && kept < n) {
+    std::size_t best = kept;
+    for (std::size_t i = kept + 1; i < n; ++i) {
+      if (scratch[i] > scratch[best]) best = i;
+    }
+    if (scratch[best] <= mergeSquared) break;
+    // Keep the order of the not-yet-kept contacts stable enough for deterministic ties: swap the
+    // chosen one into place (ties were resolved by input order in the scan above).
+    std::swap(contacts[kept], contacts[best]);
+    std::swap(scratch[kept], scratch[best]);
+    for (std::size_t i = kept + 1; i < n; ++i) {
+      scratch[i] = std::min(scratch[i], planar(contacts[i].point - contacts[kept].point));
+    }
+    ++kept;
+  }
+  return kept;
+}
+
+}  // namespace clod

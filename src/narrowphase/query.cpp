@@ -1,0 +1,773 @@
+// The anytime narrow phase: breadth-first traversal of two hierarchies under a budget, then
+// contacts from the frontier (see include/clod/query.h for the contract).
+#include "clod/query.h"
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+#include <span>
+#include <cmath>
+#include <string>
+
+#include "clod/contact_normal.h"
+#include "clod/error.h"
+#include "triangle_intersection.h"
+
+namespace clod {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Budget meter: counts tests, reads the clock once per batch (budget.h).
+
+class Meter {
+public:
+  explicit Meter(const QueryBudget& budget)
+      : limit_(budget.maxTests), deadline_(budget.deadline), now_(budget.now),
+        timed_(budget.deadline != QueryBudget::TimePoint::max()) {}
+
+  bool take() {
+    if (stopped_) return false;
+    if (used_ >= limit_) {
+      stop_ = QueryStop::kTestBudget;
+      stopped_ = true;
+      return false;
+    }
+    if (timed_) {
+      if (batchLeft_ == 0) {
+        if (now_() >= deadline_) {
+          stop_ = QueryStop::kDeadline;
+          stopped_ = true;
+          return false;
+        }
+        batchLeft_ = kDeadlineBatch;
+      }
+      --batchLeft_;
+    }
+    ++used_;
+    return true;
+  }
+  bool stopped() const { return stopped_; }
+  QueryStop stop() const { return stop_; }
+  std::uint64_t used() const { return used_; }
+
+private:
+  std::uint64_t limit_;
+  QueryBudget::TimePoint deadline_;
+  QueryBudget::TimePoint (*now_)();
+  bool timed_;
+  // The first batch starts without a clock read (budget.h).
+  std::uint32_t batchLeft_ = kDeadlineBatch;
+  std::uint64_t used_ = 0;
+  bool stopped_ = false;
+  QueryStop stop_ = QueryStop::kFinished;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Hierarchy adapters: the traversal sees a tree as nodes with a bounding sphere and children.
+
+struct SphereSide {
+  const SphereTree& tree;
+  const CollisionBody& body;
+  using Node = std::uint32_t;
+  Node root() const { return 0; }
+  Vec3 center(Node n) const { return {tree.centerX[n], tree.centerY[n], tree.centerZ[n]}; }
+  double radius(Node n) const { return tree.radius[n]; }
+  bool isLeaf(Node n) const { return tree.childCount[n] == 0; }
+  std::uint32_t childCount(Node n) const { return tree.childCount[n]; }
+  Node child(Node n, std::uint32_t k) const { return tree.firstChild[n] + k; }
+  bool usable(Node) const { return true; }
+  std::uint32_t level(Node n) const { return body.sphereLevel(n); }
+  static std::uint32_t index(Node n) { return n; }
+};
+
+struct CellSide {
+  const ContactTree& tree;
+  using Node = ContactCell;
+  Node root() const { return tree.rootCell(); }
+  Vec3 center(const Node& c) const { return tree.cellCenter(c); }
+  double radius(const Node& c) const { return tree.cellRadius(c.depth); }
+  bool isLeaf(const Node& c) const { return tree.isLeaf(c.node); }
+  std::uint32_t childCount(const Node&) const { return 8; }
+  Node child(const Node& c, std::uint32_t k) const { return tree.childCell(c, k); }
+  // A cell the field proves to be wholly outside its body holds neither surface nor interior:
+  // nothing of it can touch the other body. This is a property of the cell alone, not a test.
+  bool usable(const Node& c) const { return tree.minDistance(c) <= 0.0; }
+  std::uint32_t level(const Node& c) const { return c.depth; }
+  static std::uint32_t index(const Node& c) { return c.node; }
+};
+
+template <class NA, class NB>
+struct NodePair {
+  NA a;
+  NB b;
+  double priority;  // sphere penetration r_A + r_B - |c_A - c_B|
+};
+
+using SpherePair = NodePair<std::uint32_t, std::uint32_t>;
+using CellPair = NodePair<ContactCell, ContactCell>;
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+struct QueryScratch::Impl {
+  std::vector<SpherePair> sphereFront, sphereNext, sphereSeparated;
+  std::vector<CellPair> cellFront, cellNext, cellSeparated;
+  struct TrianglePairRef {
+    std::uint32_t ta, tb, pair;
+  };
+  std::vector<TrianglePairRef> trianglePairs;
+  struct KeyedContact {
+    std::uint64_t key;
+    Contact contact;
+  };
+  std::vector<KeyedContact> exactContacts;
+  std::vector<std::uint8_t> pairDone;
+  std::vector<std::array<std::uint32_t, 2>> volumePairs;
+  std::vector<std::uint32_t> clippers;
+  std::vector<Vec3> poly, polyTmp, insideA, insideB;
+  std::vector<Contact> raw;
+  std::vector<ContactPoint> sampled;
+  std::vector<double> manifold;
+};
+
+QueryScratch::QueryScratch() : impl_(std::make_unique<Impl>()) {}
+QueryScratch::~QueryScratch() = default;
+QueryScratch::QueryScratch(QueryScratch&&) noexcept = default;
+QueryScratch& QueryScratch::operator=(QueryScratch&&) noexcept = default;
+
+struct CoherenceCache::Impl {
+  const CollisionBody* a = nullptr;
+  const CollisionBody* b = nullptr;
+  bool cells = false;  // which lists below are in use
+  bool valid = false;
+  std::vector<SpherePair> sphereOverlapping, sphereSeparated;
+  std::vector<CellPair> cellOverlapping, cellSeparated;
+};
+
+CoherenceCache::CoherenceCache() : impl_(std::make_unique<Impl>()) {}
+CoherenceCache::~CoherenceCache() = default;
+CoherenceCache::CoherenceCache(CoherenceCache&&) noexcept = default;
+CoherenceCache& CoherenceCache::operator=(CoherenceCache&&) noexcept = default;
+void CoherenceCache::clear() noexcept {
+  impl_->valid = false;
+  impl_->sphereOverlapping.clear();
+  impl_->sphereSeparated.clear();
+  impl_->cellOverlapping.clear();
+  impl_->cellSeparated.clear();
+}
+std::size_t CoherenceCache::frontSize() const noexcept {
+  if (!impl_->valid) return 0;
+  return impl_->cells ? impl_->cellOverlapping.size() + impl_->cellSeparated.size()
+                      : impl_->sphereOverlapping.size() + impl_->sphereSeparated.size();
+}
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// The traversal. All geometry is in A's frame: B's centres are moved once per test.
+
+enum class TestOutcome : std::uint8_t { kOverlap, kSeparated, kOutOfBudget };
+
+template <class SideA, class SideB>
+class Traversal {
+public:
+  using NA = typename SideA::Node;
+  using NB = typename SideB::Node;
+  using Pair = NodePair<NA, NB>;
+
+  Traversal(const SideA& a, const SideB& b, const Pose& xfAFromB, Meter& meter)
+      : a_(a), b_(b), xfAFromB_(xfAFromB), meter_(meter) {}
+
+  TestOutcome test(const Vec3& centerA, double radiusA, const Vec3& centerBinA, double radiusB, double& penetration) {
+    if (!meter_.take()) return TestOutcome::kOutOfBudget;
+    const double d2 = (centerA - centerBinA).squaredNorm();
+    const double rr = radiusA + radiusB;
+    if (d2 > rr * rr) return TestOutcome::kSeparated;
+    penetration = rr - std::sqrt(d2);
+    return TestOutcome::kOverlap;
+  }
+
+  Vec3 centerB(const NB& n) const { return xfAFromB_.apply(b_.center(n)); }
+
+  // Re-tests a list of pairs (the roots, or a cached front): overlapping ones go to `front`,
+  // separated ones to `separated` (if tracked). When the budget runs out, the untested pairs keep
+  // the status they came with (`assumeOverlap`).
+  void retest(const std::vector<Pair>& pairs, bool assumeOverlap, std::vector<Pair>& front,
+              std::vector<Pair>* separated) {
+    for (const Pair& p : pairs) {
+      double pen = 0.0;
+      const TestOutcome o = test(a_.center(p.a), a_.radius(p.a), centerB(p.b), b_.radius(p.b), pen);
+      if (o == TestOutcome::kOverlap) {
+        front.push_back({p.a, p.b, pen});
+      } else if (o == TestOutcome::kSeparated) {
+        if (separated) separated->push_back({p.a, p.b, pen});
+      } else if (assumeOverlap) {
+        front.push_back(p);
+      } else if (separated) {
+        separated->push_back(p);
+      }
+    }
+  }
+
+  // Rounds of expansion until every pair is final or the budget is out. Returns true when
+  // finished. `front` holds the answer frontier afterwards.
+  bool refine(std::vector<Pair>& front, std::vector<Pair>& next, std::vector<Pair>* separated) {
+    for (;;) {
+      std::sort(front.begin(), front.end(), [](const Pair& x, const Pair& y) {
+        if (x.priority != y.priority) return x.priority > y.priority;
+        if (SideA::index(x.a) != SideA::index(y.a)) return SideA::index(x.a) < SideA::index(y.a);
+        return SideB::index(x.b) < SideB::index(y.b);
+      });
+      next.clear();
+      bool expanded = false;
+      for (std::size_t i = 0; i < front.size(); ++i) {
+        const Pair& p = front[i];
+        const bool leafA = a_.isLeaf(p.a);
+        const bool leafB = b_.isLeaf(p.b);
+        if (leafA && leafB) {
+          next.push_back(p);
+          continue;
+        }
+        const double rA = a_.radius(p.a);
+        const double rB = b_.radius(p.b);
+        const bool descendA = !leafA && (leafB || rA >= rB);
+        const std::size_t mark = next.size();
+        const std::size_t sepMark = separated ? separated->size() : 0;
+        bool out = false;
+        if (descendA) {
+          const Vec3 cB = centerB(p.b);
+          for (std::uint32_t k = 0, n = a_.childCount(p.a); k < n; ++k) {
+            const NA c = a_.child(p.a, k);
+            if (!a_.usable(c)) continue;
+            double pen = 0.0;
+            const TestOutcome o = test(a_.center(c), a_.radius(c), cB, rB, pen);
+            if (o == TestOutcome::kOutOfBudget) {
+              out = true;
+              break;
+            }
+            if (o == TestOutcome::kOverlap) {
+              next.push_back({c, p.b, pen});
+            } else if (separated) {
+              separated->push_back({c, p.b, pen});
+            }
+          }
+        } else {
+          const Vec3 cA = a_.center(p.a);
+          for (std::uint32_t k = 0, n = b_.childCount(p.b); k < n; ++k) {
+            const NB c = b_.child(p.b, k);
+            if (!b_.usable(c)) continue;
+            double pen = 0.0;
+            const TestOutcome o = test(cA, rA, centerB(c), b_.radius(c), pen);
+            if (o == TestOutcome::kOutOfBudget) {
+              out = true;
+              break;
+            }
+            if (o == TestOutcome::kOverlap) {
+              next.push_back({p.a, c, pen});
+            } else if (separated) {
+              separated->push_back({p.a, c, pen});
+            }
+          }
+        }
+        if (out) {
+          // Keep the pair whole: drop this expansion's partial results, keep the rest as is.
+          next.resize(mark);
+          if (separated) separated->resize(sepMark);
+          next.insert(next.end(), front.begin() + static_cast<std::ptrdiff_t>(i), front.end());
+          front.swap(next);
+          return false;
+        }
+        expanded = true;
+      }
+      front.swap(next);
+      if (!expanded) return true;
+    }
+  }
+
+private:
+  const SideA& a_;
+  const SideB& b_;
+  Pose xfAFromB_;
+  Meter& meter_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Contacts from sphere pairs.
+
+// Dingliana & O'Sullivan's point: where the plane of the two spheres' intersection circle cuts
+// the centre line. With d = |c_A - c_B| and u = (c_A - c_B)/d, that plane is at distance
+// x = (d^2 + r_B^2 - r_A^2) / (2d) from c_B along u (the radical plane). When one sphere holds
+// the other the plane leaves the segment; x is clamped to B's sphere so the point stays in both.
+struct DosContact {
+  Vec3 point;   // A frame
+  Vec3 normal;  // A frame, B -> A
+  double depth;
+};
+
+DosContact dosContact(const Vec3& cA, double rA, const Vec3& cB, double rB) {
+  const Vec3 delta = cA - cB;
+  const double d = delta.norm();
+  DosContact c;
+  c.depth = rA + rB - d;
+  if (d <= 1e-300) {
+    // Concentric: any direction is as good as any other; +z of A's frame, point at the centre.
+    c.normal = Vec3::UnitZ();
+    c.point = cB;
+    return c;
+  }
+  c.normal = delta / d;
+  const double x = std::clamp((d * d + rB * rB - rA * rA) / (2.0 * d), std::max(0.0, d - rA), std::min(d, rB));
+  c.point = cB + x * c.normal;
+  return c;
+}
+
+// How the two spheres' normals are combined (docs/narrow-phase.md). u is the D&O normal (B's
+// centre toward A's); A's outward normal should face B (n_A . u < 0), B's should face A.
+//  1. if they agree (n_B and -n_A within 10 deg), n = normalize(n_B - n_A): both surfaces'
+//     normals; for face-on-face n_A = -n_B so n = n_B, on smooth bodies their average;
+//  2. if exactly one of them faces the other sphere, it wins: the other sphere's lookup found
+//     a feature that turns away from the contact (a loose sphere whose nearest surface is a side
+//     face, not the one touching);
+//  3. if exactly one of them is a face normal of its sphere's triangles
+//     (CollisionBody::sphereFaceNormals; an edge or vertex pseudonormal is not), it wins: an edge
+//     or corner meeting a face is pushed along the face normal;
+//  4. otherwise the one that faces the other sphere more (larger n_B . u or -n_A . u): of two
+//     faces of a box meeting another box, the one turned toward the contact.
+// (A vanishing rule-1 normal, n_A = n_B, gives the D&O normal.)
+constexpr double kAgreeCos = 0.984807753012208;   // cos 10 deg
+constexpr double kFaceMatchCos = 0.99939082701909; // cos 2 deg: above the 16-bit codec's ~0.95 deg
+
+bool isFaceNormal(const Vec3& nLocal, std::span<const Vec3f> faces) {
+  for (const Vec3f& f : faces) {
+    if (f.cast<double>().dot(nLocal) > kFaceMatchCos) return true;
+  }
+  return false;
+}
+
+Vec3 differenceNormal(const Vec3& nA, const Vec3& nB, const Vec3& dosNormal) {
+  const Vec3 sum = nB - nA;
+  const double len = sum.norm();
+  if (len < 1e-9) return dosNormal;
+  return sum / len;
+}
+
+void sphereContacts(ContactModel model, const CollisionBody& bodyA, const CollisionBody& bodyB, const Pose& xfAFromB,
+                    const std::vector<SpherePair>& front, std::vector<Contact>& out) {
+  const SphereTree& ta = bodyA.sphereTree();
+  const SphereTree& tb = bodyB.sphereTree();
+  for (const SpherePair& p : front) {
+    const Vec3 cA = ta.center(p.a);
+    const Vec3 cB = xfAFromB.apply(tb.center(p.b));
+    const double rA = ta.radius[p.a];
+    const double rB = tb.radius[p.b];
+    const DosContact dos = dosContact(cA, rA, cB, rB);
+    Contact c;
+    c.point = dos.point;
+    c.depth = dos.depth;
+    c.errorBound = rA + rB;
+    c.level = std::max(bodyA.sphereLevel(p.a), bodyB.sphereLevel(p.b));
+    if (model == ContactModel::kDos) {
+      c.normal = dos.normal;
+    } else {
+      const ContactNormalModel m =
+          model == ContactModel::kCfm ? ContactNormalModel::kClosestFeatureMap : ContactNormalModel::kAverage;
+      const ClosestFeatureMap& mapA = bodyA.closestFeatureMap();
+      const ClosestFeatureMap& mapB = bodyB.closestFeatureMap();
+      // Each sphere is looked up at its surface point facing the other sphere: the sample
+      // nearest the D&O point whenever that point lies between the centres, and still the
+      // side facing the contact when a large sphere's radical plane lies beyond the small
+      // sphere's centre (then the D&O point would look up the small sphere's far side).
+      const Vec3 nA = contactNormal(m, ta, mapA, p.a, cA - rA * dos.normal);
+      const Vec3 pointB = xfAFromB.applyInverse(cB + rB * dos.normal);
+      const Vec3 nBlocal = contactNormal(m, tb, mapB, p.b, pointB);
+      const Vec3 nB = xfAFromB.rotation * nBlocal;
+      // The face test only matters where the normals disagree (rule 2), and only for cfm: the
+      // average model is the paper's straw man and stays plain.
+      c.normal = differenceNormal(nA, nB, dos.normal);
+      if (model == ContactModel::kCfm && nB.dot(-nA) < kAgreeCos) {
+        const bool facingA = nA.dot(dos.normal) < 0.0;
+        const bool facingB = nB.dot(dos.normal) > 0.0;
+        if (facingA != facingB) {
+          c.normal = facingB ? nB : Vec3(-nA);
+        } else {
+          const bool faceA = isFaceNormal(nA, bodyA.sphereFaceNormals(p.a));
+          const bool faceB = isFaceNormal(nBlocal, bodyB.sphereFaceNormals(p.b));
+          if (faceA != faceB) {
+            c.normal = faceB ? nB : Vec3(-nA);
+          } else {
+            c.normal = nB.dot(dos.normal) >= -nA.dot(dos.normal) ? nB : Vec3(-nA);
+          }
+        }
+      }
+    }
+    out.push_back(c);
+  }
+}
+
+Contact toWorld(const Contact& local, const Pose& xfWorldFromA) {
+  Contact c = local;
+  c.point = xfWorldFromA.apply(local.point);
+  c.normal = xfWorldFromA.rotation * local.normal;
+  return c;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Exact model: triangle pairs of the leaf x leaf frontier pairs.
+
+// The exact model's normal: the gradient of the intersection volume V of the two bodies. Moving
+// A by dx changes V by -dx . (integral of n_A over A's surface inside B), so the direction that
+// shrinks V fastest is N = integral over B's surface inside A of n_B dA - integral over A's
+// surface inside B of n_A dA (the two agree for closed meshes, by the divergence theorem; using
+// both halves the discretisation error). The part of a triangle inside the other body is taken
+// as the triangle clipped by the inner half-spaces of the other body's triangles it intersects:
+// exact where the other surface is locally convex, an approximation where it is concave, and
+// triangles lying wholly inside the other body (no intersection) are not counted. Depth is the
+// extent of those inside parts along N: max over B's parts of N.x - min over A's parts of N.x.
+// For a box resting on a box this gives the face normal (tilted by ~depth/width from the thin
+// side strips) and the penetration; for two spheres, the centre line and the lens thickness.
+void clipByHalfSpaces(const Vec3& p0, const Vec3& p1, const Vec3& p2, const TriangleMesh& other,
+                      const Pose& xfSelfFromOther, std::span<const std::uint32_t> clippers, std::vector<Vec3>& poly,
+                      std::vector<Vec3>& tmp) {
+  poly.assign({p0, p1, p2});
+  for (std::uint32_t t : clippers) {
+    const Vec3 o0 = xfSelfFromOther.apply(other.corner(t, 0));
+    const Vec3 n = xfSelfFromOther.rotation * other.triangleNormal(t);
+    tmp.clear();
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+      const Vec3& p = poly[i];
+      const Vec3& q = poly[(i + 1) % poly.size()];
+      const double dp = n.dot(p - o0);
+      const double dq = n.dot(q - o0);
+      if (dp <= 0.0) tmp.push_back(p);
+      if ((dp < 0.0 && dq > 0.0) || (dp > 0.0 && dq < 0.0)) tmp.push_back(p + (dp / (dp - dq)) * (q - p));
+    }
+    poly.swap(tmp);
+    if (poly.empty()) return;
+  }
+}
+
+Vec3 polygonAreaVector(const std::vector<Vec3>& poly) {
+  Vec3 sum = Vec3::Zero();
+  for (std::size_t i = 1; i + 1 < poly.size(); ++i) sum += (poly[i] - poly[0]).cross(poly[i + 1] - poly[0]);
+  return 0.5 * sum;
+}
+
+void penetrationVolumeNormal(const TriangleMesh& ma, const TriangleMesh& mb, const Pose& xfAFromB,
+                             QueryScratch::Impl& s, Vec3& normal, double& depth) {
+  auto& pairs = s.volumePairs;
+  if (pairs.empty()) return;
+  s.insideA.clear();
+  s.insideB.clear();
+  Vec3 sum = Vec3::Zero();
+  const Pose xfBFromA = xfAFromB.inverse();
+  // A's triangles, each clipped by the B triangles it meets (pairs sorted by A's triangle).
+  std::sort(pairs.begin(), pairs.end());
+  for (std::size_t i = 0; i < pairs.size();) {
+    std::size_t j = i;
+    s.clippers.clear();
+    while (j < pairs.size() && pairs[j][0] == pairs[i][0]) s.clippers.push_back(pairs[j++][1]);
+    const std::uint32_t t = pairs[i][0];
+    clipByHalfSpaces(ma.corner(t, 0), ma.corner(t, 1), ma.corner(t, 2), mb, xfAFromB, s.clippers, s.poly, s.polyTmp);
+    sum -= polygonAreaVector(s.poly);  // its area vector is n_A * area (counter-clockwise)
+    s.insideA.insert(s.insideA.end(), s.poly.begin(), s.poly.end());
+    i = j;
+  }
+  // B's triangles, clipped by the A triangles they meet, in B's frame, then moved to A's.
+  std::sort(pairs.begin(), pairs.end(), [](const auto& x, const auto& y) { return x[1] != y[1] ? x[1] < y[1] : x[0] < y[0]; });
+  for (std::size_t i = 0; i < pairs.size();) {
+    std::size_t j = i;
+    s.clippers.clear();
+    while (j < pairs.size() && pairs[j][1] == pairs[i][1]) s.clippers.push_back(pairs[j++][0]);
+    const std::uint32_t t = pairs[i][1];
+    clipByHalfSpaces(mb.corner(t, 0), mb.corner(t, 1), mb.corner(t, 2), ma, xfBFromA, s.clippers, s.poly, s.polyTmp);
+    sum += xfAFromB.rotation * polygonAreaVector(s.poly);
+    for (const Vec3& p : s.poly) s.insideB.push_back(xfAFromB.apply(p));
+    i = j;
+  }
+  const double len = sum.norm();
+  if (!(len > 0.0)) return;
+  normal = sum / len;
+  double maxB = -std::numeric_limits<double>::infinity();
+  double minA = std::numeric_limits<double>::infinity();
+  for (const Vec3& p : s.insideB) maxB = std::max(maxB, normal.dot(p));
+  for (const Vec3& p : s.insideA) minA = std::min(minA, normal.dot(p));
+  depth = (s.insideA.empty() || s.insideB.empty()) ? 0.0 : std::max(0.0, maxB - minA);
+}
+
+// Returns true if every frontier pair got its triangle tests.
+bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const Pose& xfAFromB,
+                   const std::vector<SpherePair>& front, bool traversalFinished, Meter& meter,
+                   QueryScratch::Impl& s, std::vector<Contact>& out, std::uint64_t& triangleTests,
+                   std::vector<std::array<std::uint32_t, 2>>& hits) {
+  const SphereTree& ta = bodyA.sphereTree();
+  const SphereTree& tb = bodyB.sphereTree();
+  const TriangleMesh& ma = bodyA.mesh();
+  const TriangleMesh& mb = bodyB.mesh();
+  s.pairDone.assign(front.size(), 0);
+  s.trianglePairs.clear();
+  s.exactContacts.clear();
+  s.volumePairs.clear();
+  hits.clear();
+  bool complete = traversalFinished;
+  if (traversalFinished) {
+    // A triangle can belong to several leaves: test each triangle pair once, on behalf of the
+    // highest-priority frontier pair that holds it (front is sorted by priority).
+    for (std::uint32_t i = 0; i < front.size(); ++i) {
+      for (std::uint32_t triA : ta.triangles(front[i].a)) {
+        for (std::uint32_t triB : tb.triangles(front[i].b)) s.trianglePairs.push_back({triA, triB, i});
+      }
+    }
+    using Ref = QueryScratch::Impl::TrianglePairRef;
+    std::sort(s.trianglePairs.begin(), s.trianglePairs.end(), [](const Ref& x, const Ref& y) {
+      if (x.ta != y.ta) return x.ta < y.ta;
+      if (x.tb != y.tb) return x.tb < y.tb;
+      return x.pair < y.pair;
+    });
+    s.trianglePairs.erase(std::unique(s.trianglePairs.begin(), s.trianglePairs.end(),
+                                      [](const Ref& x, const Ref& y) { return x.ta == y.ta && x.tb == y.tb; }),
+                          s.trianglePairs.end());
+    std::stable_sort(s.trianglePairs.begin(), s.trianglePairs.end(),
+                     [](const Ref& x, const Ref& y) { return x.pair < y.pair; });
+
+    // Plane-distance tolerance: rounding of coordinates of the size of the two bodies.
+    const double eps = 1e-12 * (bodyA.diagonal() + bodyB.diagonal() + xfAFromB.translation.norm());
+    narrowphase::TriangleIntersection hit;
+    std::size_t k = 0;
+    const std::size_t n = s.trianglePairs.size();
+    for (std::uint32_t i = 0; i < front.size() && complete; ++i) {
+      for (; k < n && s.trianglePairs[k].pair == i; ++k) {
+        if (!meter.take()) {
+          complete = false;
+          break;
+        }
+        ++triangleTests;
+        const auto& ref = s.trianglePairs[k];
+        const Vec3 b0 = xfAFromB.apply(mb.corner(ref.tb, 0));
+        const Vec3 b1 = xfAFromB.apply(mb.corner(ref.tb, 1));
+        const Vec3 b2 = xfAFromB.apply(mb.corner(ref.tb, 2));
+        if (!narrowphase::intersectTriangles(ma.corner(ref.ta, 0), ma.corner(ref.ta, 1), ma.corner(ref.ta, 2), b0, b1,
+                                             b2, eps, hit)) {
+          continue;
+        }
+        hits.push_back({ref.ta, ref.tb});
+        // Coplanar triangles facing the same way are flush side by side (two boxes' aligned side
+        // faces), not pressed against each other: no contact.
+        if (hit.coplanar && hit.normalA.dot(hit.normalB) > 0.0) continue;
+        s.volumePairs.push_back({ref.ta, ref.tb});
+        // Normal and depth are filled in below, once all intersecting pairs are known.
+        const std::uint64_t key = (std::uint64_t{ref.ta} << 32) | ref.tb;
+        Contact c;
+        c.errorBound = 0.0;
+        c.level = std::max(bodyA.sphereLevel(front[i].a), bodyB.sphereLevel(front[i].b));
+        for (std::uint32_t q = 0; q < hit.count; ++q) {
+          c.point = hit.points[q];
+          s.exactContacts.push_back({key, c});
+        }
+      }
+      if (complete) s.pairDone[i] = 1;
+    }
+  }
+  if (complete) {
+    // Finished: order by triangle pair, so the answer does not depend on the frontier's order.
+    std::stable_sort(s.exactContacts.begin(), s.exactContacts.end(),
+                     [](const auto& x, const auto& y) { return x.key < y.key; });
+  }
+  Vec3 normal = Vec3::UnitZ();
+  double depth = 0.0;
+  penetrationVolumeNormal(ma, mb, xfAFromB, s, normal, depth);
+  for (auto& kc : s.exactContacts) {
+    kc.contact.normal = normal;
+    kc.contact.depth = depth;
+    out.push_back(kc.contact);
+  }
+  std::sort(hits.begin(), hits.end());
+  return complete;
+}
+
+void throwMissing(const CollisionBody& body, const char* which, const char* what, const char* model,
+                  const char* option) {
+  throw Error(ErrorCode::kBakeMissingSection, std::string("body ") + which +
+                                                  (body.name().empty() ? "" : " ('" + body.name() + "')") + " has no " +
+                                                  what + ", which the " + model + " model needs (bake with " + option +
+                                                  ")");
+}
+
+void checkSettings(const QuerySettings& s) {
+  if (s.maxContacts == 0) throw Error(ErrorCode::kInvalidArgument, "maxContacts must be >= 1");
+  if (s.budget.maxTests == 0) throw Error(ErrorCode::kInvalidArgument, "budget maxTests must be >= 1");
+  if (!(s.mergeDistanceRel >= 0.0) || !std::isfinite(s.mergeDistanceRel)) {
+    throw Error(ErrorCode::kInvalidArgument, "mergeDistanceRel must be finite and >= 0");
+  }
+  if (s.budget.now == nullptr) throw Error(ErrorCode::kInvalidArgument, "budget clock is null");
+}
+
+template <class Pair, class SideA, class SideB>
+void fillFrontier(const std::vector<Pair>& front, const SideA& sa, const SideB& sb, QueryResult& result) {
+  result.frontier.clear();
+  result.minLevel = 0;
+  result.maxLevel = 0;
+  bool first = true;
+  for (const Pair& p : front) {
+    FrontierPair f{SideA::index(p.a), SideB::index(p.b), sa.level(p.a), sb.level(p.b)};
+    result.frontier.push_back(f);
+    const std::uint32_t level = std::max(f.levelA, f.levelB);
+    result.minLevel = first ? level : std::min(result.minLevel, level);
+    result.maxLevel = first ? level : std::max(result.maxLevel, level);
+    first = false;
+  }
+}
+
+// Runs the traversal from the roots or from a cache's front. Returns true when finished.
+template <class SideA, class SideB, class Pair>
+bool traverse(const SideA& sa, const SideB& sb, const Pose& xfAFromB, Meter& meter, std::vector<Pair>& front,
+              std::vector<Pair>& next, std::vector<Pair>& separated, bool track, std::vector<Pair>* cachedOverlap,
+              std::vector<Pair>* cachedSeparated) {
+  Traversal<SideA, SideB> t(sa, sb, xfAFromB, meter);
+  front.clear();
+  separated.clear();
+  std::vector<Pair>* sep = track ? &separated : nullptr;
+  if (cachedOverlap != nullptr) {
+    // Last frame's overlapping pairs first (deepest first, as they were left), then the
+    // separated ones; under a tight budget the untested keep last frame's status.
+    t.retest(*cachedOverlap, true, front, sep);
+    t.retest(*cachedSeparated, false, front, sep);
+  } else {
+    next.clear();
+    next.push_back({sa.root(), sb.root(), 0.0});
+    t.retest(next, false, front, sep);
+  }
+  return t.refine(front, next, sep);
+}
+
+}  // namespace
+
+void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const CollisionBody& b, const Pose& xfWorldFromB,
+                   const QuerySettings& settings, QueryScratch& scratch, QueryResult& result, CoherenceCache* cache) {
+  const auto start = std::chrono::steady_clock::now();
+  checkSettings(settings);
+  const ContactModel model = settings.model;
+  if (model == ContactModel::kCfm || model == ContactModel::kAverage) {
+    const char* name = model == ContactModel::kCfm ? "cfm" : "average";
+    if (!a.hasClosestFeatureMap()) throwMissing(a, "A", "closest feature map", name, "--cfm");
+    if (!b.hasClosestFeatureMap()) throwMissing(b, "B", "closest feature map", name, "--cfm");
+  }
+  if (model == ContactModel::kContactTree) {
+    if (!a.hasContactTree()) throwMissing(a, "A", "contact tree", "contact-tree", "--contact-tree");
+    if (!b.hasContactTree()) throwMissing(b, "B", "contact tree", "contact-tree", "--contact-tree");
+  }
+
+  QueryScratch::Impl& s = scratch.impl();
+  const Pose xfAFromB = xfWorldFromA.inverse() * xfWorldFromB;
+  Meter meter(settings.budget);
+  result.contacts.clear();
+  result.triangleTests = 0;
+  result.intersectingTriangles.clear();
+  s.raw.clear();
+
+  const bool cells = model == ContactModel::kContactTree;
+  CoherenceCache::Impl* c = cache ? &cache->impl() : nullptr;
+  const bool warm = c != nullptr && c->valid && c->a == &a && c->b == &b && c->cells == cells;
+  bool finished = false;
+
+  if (!cells) {
+    const SphereSide sa{a.sphereTree(), a};
+    const SphereSide sb{b.sphereTree(), b};
+    finished = traverse(sa, sb, xfAFromB, meter, s.sphereFront, s.sphereNext, s.sphereSeparated, c != nullptr,
+                        warm ? &c->sphereOverlapping : nullptr, warm ? &c->sphereSeparated : nullptr);
+    fillFrontier(s.sphereFront, sa, sb, result);
+    if (model == ContactModel::kExact) {
+      const bool complete =
+          exactContacts(a, b, xfAFromB, s.sphereFront, finished, meter, s, s.raw, result.triangleTests,
+                        result.intersectingTriangles);
+      if (!complete) {
+        // Frontier pairs that did not get their triangle tests answer with D&O contacts.
+        s.sphereNext.clear();
+        for (std::size_t i = 0; i < s.sphereFront.size(); ++i) {
+          if (!s.pairDone[i]) s.sphereNext.push_back(s.sphereFront[i]);
+        }
+        sphereContacts(ContactModel::kDos, a, b, xfAFromB, s.sphereNext, s.raw);
+        finished = false;
+      }
+      result.colliding = complete ? !s.raw.empty() : !s.sphereFront.empty();
+    } else {
+      sphereContacts(model, a, b, xfAFromB, s.sphereFront, s.raw);
+      result.colliding = !s.sphereFront.empty();
+    }
+    if (c != nullptr) {
+      c->a = &a;
+      c->b = &b;
+      c->cells = false;
+      c->valid = !s.sphereFront.empty();
+      c->sphereOverlapping.assign(s.sphereFront.begin(), s.sphereFront.end());
+      c->sphereSeparated.assign(s.sphereSeparated.begin(), s.sphereSeparated.end());
+    }
+    for (Contact& ct : s.raw) ct = toWorld(ct, xfWorldFromA);
+  } else {
+    const CellSide sa{a.contactTree()};
+    const CellSide sb{b.contactTree()};
+    finished = traverse(sa, sb, xfAFromB, meter, s.cellFront, s.cellNext, s.cellSeparated, c != nullptr,
+                        warm ? &c->cellOverlapping : nullptr, warm ? &c->cellSeparated : nullptr);
+    fillFrontier(s.cellFront, sa, sb, result);
+    ContactSamplingSettings sampling = settings.contactSampling;
+    sampling.maxDepth = kContactTreeLeafDepth;
+    s.sampled.clear();
+    for (const CellPair& p : s.cellFront) {
+      // Field queries always go to the leaves: the budget buys traversal, and a coarse cell's
+      // trilinear field is too smooth to say whether a sample penetrates (measured: a box on a
+      // box then gets no contact at all from a 16-test traversal). O(depth) per sample.
+      const std::size_t first = s.sampled.size();
+      sampleCellPair(a.contactTree(), p.a, xfWorldFromA, b.contactTree(), p.b, xfWorldFromB, sampling, s.sampled);
+      const std::size_t mid = s.sampled.size();
+      sampleCellPair(b.contactTree(), p.b, xfWorldFromB, a.contactTree(), p.a, xfWorldFromA, sampling, s.sampled);
+      // The reverse call's normals point out of A toward B: flip them to B -> A.
+      for (std::size_t i = mid; i < s.sampled.size(); ++i) s.sampled[i].normal = -s.sampled[i].normal;
+      const std::uint32_t level = std::max(p.a.depth, p.b.depth);
+      for (std::size_t i = first; i < s.sampled.size(); ++i) {
+        const ContactPoint& cp = s.sampled[i];
+        if (cp.depth < -settings.contactSampling.marginAbs) continue;
+        Contact ct;
+        ct.point = cp.point;
+        ct.normal = cp.normal;
+        ct.depth = cp.depth;
+        ct.errorBound = cp.errorBound;
+        ct.level = level;
+        s.raw.push_back(ct);
+      }
+    }
+    result.colliding = !s.raw.empty();
+    if (c != nullptr) {
+      c->a = &a;
+      c->b = &b;
+      c->cells = true;
+      c->valid = !s.cellFront.empty();
+      c->cellOverlapping.assign(s.cellFront.begin(), s.cellFront.end());
+      c->cellSeparated.assign(s.cellSeparated.begin(), s.cellSeparated.end());
+    }
+  }
+
+  result.rawContacts = s.raw.size();
+  ManifoldSettings manifold;
+  manifold.maxContacts = settings.maxContacts;
+  manifold.mergeDistanceAbs = settings.mergeDistanceRel * std::min(a.diagonal(), b.diagonal());
+  const std::size_t kept = reduceManifold(s.raw, manifold, s.manifold);
+  result.contacts.assign(s.raw.begin(), s.raw.begin() + static_cast<std::ptrdiff_t>(kept));
+  std::stable_sort(result.contacts.begin(), result.contacts.end(),
+                   [](const Contact& x, const Contact& y) { return x.depth > y.depth; });
+
+  result.tests = meter.used();
+  result.sphereTests = result.tests - result.triangleTests;
+  result.finished = finished && !meter.stopped();
+  result.stop = result.finished ? QueryStop::kFinished : (meter.stopped() ? meter.stop() : QueryStop::kTestBudget);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+QueryResult queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const CollisionBody& b,
+                          const Pose& xfWorldFromB, const QuerySettings& settings) {
+  QueryScratch scratch;
+  QueryResult result;
+  queryContacts(a, xfWorldFromA, b, xfWorldFromB, settings, scratch, result);
+  return result;
+}
+
+}  // namespace clod

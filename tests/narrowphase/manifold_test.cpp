@@ -1,0 +1,62 @@
+// Manifold reduction against analytic answers.
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "clod/contact.h"
+#include "clod/error.h"
+
+namespace clod {
+namespace {
+
+Contact at(double x, double y, double depth) {
+  Contact c;
+  c.point = Vec3(x, y, 0.0);
+  c.normal = Vec3::UnitZ();
+  c.depth = depth;
+  return c;
+}
+
+TEST(ReduceManifold, KeepsTheDeepestThenTheCornersOfASquareGrid) {
+  // An 11 x 11 grid on [0,1]^2; the deepest contact is the centre. Farthest-point sampling from
+  // the centre picks the four corners next (all at distance sqrt(2)/2, the largest).
+  std::vector<Contact> contacts;
+  for (int i = 0; i <= 10; ++i)
+    for (int j = 0; j <= 10; ++j) contacts.push_back(at(0.1 * i, 0.1 * j, (i == 5 && j == 5) ? 0.2 : 0.1));
+  std::vector<double> scratch;
+  const std::size_t n = reduceManifold(contacts, {5, 0.0}, scratch);
+  ASSERT_EQ(n, 5u);
+  EXPECT_EQ(contacts[0].point, Vec3(0.5, 0.5, 0.0));
+  for (std::size_t i = 1; i < 5; ++i) {
+    EXPECT_NEAR(std::abs(contacts[i].point.x() - 0.5), 0.5, 1e-12);
+    EXPECT_NEAR(std::abs(contacts[i].point.y() - 0.5), 0.5, 1e-12);
+  }
+}
+
+TEST(ReduceManifold, MergesCoincidentContactsAndMeasuresInTheContactPlane) {
+  // Five copies of two spots, stacked along the normal at different depths: two contacts remain.
+  std::vector<Contact> contacts;
+  for (int k = 0; k < 5; ++k) {
+    Contact c = at(0.0, 0.0, 0.1 + 0.01 * k);
+    c.point.z() = -0.01 * k;
+    contacts.push_back(c);
+    contacts.push_back(at(1.0, 0.0, 0.05));
+  }
+  std::vector<double> scratch;
+  const std::size_t n = reduceManifold(contacts, {8, 1e-3}, scratch);
+  ASSERT_EQ(n, 2u);
+  EXPECT_DOUBLE_EQ(contacts[0].depth, 0.14);
+  EXPECT_NEAR(contacts[1].point.x(), 1.0, 1e-15);
+}
+
+TEST(ReduceManifold, RejectsBadSettings) {
+  std::vector<Contact> contacts{at(0, 0, 0)};
+  std::vector<double> scratch;
+  EXPECT_THROW(reduceManifold(contacts, {0, 0.0}, scratch), Error);
+  EXPECT_THROW(reduceManifold(contacts, {4, -1.0}, scratch), Error);
+  EXPECT_EQ(reduceManifold(std::span<Contact>(), {4, 0.0}, scratch), 0u);
+}
+
+}  // namespace
+}  // namespace clod

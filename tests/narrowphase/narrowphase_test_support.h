@@ -1,0 +1,43 @@
+#pragma once
+// Bodies baked in-process for the narrow-phase tests (small trees, to keep the tests fast).
+
+#include <cstdlib>
+#include <string>
+
+#include "clod/bake.h"
+#include "clod/closest_feature_map.h"
+#include "clod/collision_body.h"
+#include "clod/contact_tree_builder.h"
+#include "clod/proximity.h"
+
+namespace clod::test {
+
+inline bool sanitizerRun() {
+  const char* scale = std::getenv("CLOD_TEST_SCALE");
+  return scale != nullptr && std::string(scale) == "sanitizer";
+}
+
+/// A body with sphere-tree (medial, 8-ary, `depth` levels below the root), closest feature map
+/// (16 root stacks: finer than the paper's 10 so the sphere tests' tolerances stay small) and
+/// contact tree (errorRel 2e-3).
+inline CollisionBody makeTestBody(const TriangleMesh& mesh, std::uint32_t depth, bool withContactTree = true) {
+  BakeSettings settings;
+  settings.sphereTree.depth = depth;
+  settings.sphereTree.medialSamples = 2000;
+  settings.measureFit = false;
+  const BakeResult baked = bakeMesh(mesh, settings);
+  CollisionBody body = CollisionBody::fromBake(baked.contents);
+  const MeshDistance distance(mesh);
+  ClosestFeatureMapSettings cfm;
+  cfm.rootStacks = 16;
+  body.setClosestFeatureMap(buildClosestFeatureMap(distance, body.sphereTree(), cfm));
+  if (withContactTree) {
+    ContactTreeSettings ct;
+    ct.errorRel = 2e-3;
+    ct.maxDepth = 7;
+    body.setContactTree(buildContactTree(distance, ct));
+  }
+  return body;
+}
+
+}  // namespace clod::test
