@@ -17,6 +17,7 @@
 #include "clod/error.h"
 #include "clod/atomic_file.h"
 #include "clod/mesh_weld.h"
+#include "off_reader.h"
 #include "text_index_check.h"
 
 namespace clod {
@@ -127,8 +128,6 @@ bool mentionsIndexOutOfRange(const std::string& message) {
   if (mentionsIndexOutOfRange(message)) {
     std::optional<std::string> where;
     if (format == "obj") where = detail::findBadObjIndex(text);
-    if (format == "off")
-      if (auto bad = detail::findBadOffFace(text)) where = bad->message;
     throw Error(ErrorCode::kIndexOutOfRange, source + ": " + (where ? *where : message));
   }
   throw Error(ErrorCode::kParseError, source + ": " + (message.empty() ? std::string("import failed") : message));
@@ -153,6 +152,56 @@ struct Instance {
   aiMatrix4x4 transform;
 };
 
+// Everything after reading, shared by all formats: fatal checks, weld, validate, orient.
+LoadedMesh finishMesh(LoadedMesh result, std::uint64_t ignoredPrimitives, const std::string& source,
+                      const MeshLoadOptions& options) {
+  TriangleMesh& mesh = result.mesh;
+  // Readers may leave non-finite coordinates in (the Assimp path checks earlier, with the mesh
+  // and node in the message); welding needs finite ones.
+  for (std::uint32_t v = 0; v < mesh.vertexCount(); ++v) {
+    const Vec3& p = mesh.vertices[v];
+    if (!p.allFinite())
+      throw Error(ErrorCode::kNonFiniteVertex, source + ": vertex " + std::to_string(v) + ": non-finite coordinate (" +
+                                                   std::to_string(p.x()) + ", " + std::to_string(p.y()) + ", " +
+                                                   std::to_string(p.z()) + ")");
+  }
+  result.importedVertexCount = mesh.vertexCount();
+  if (mesh.triangles.empty())
+    throw Error(ErrorCode::kNoTriangles, source + ": no triangles (" + std::to_string(mesh.vertexCount()) + " vertices, " +
+                                             std::to_string(ignoredPrimitives) + " points/lines)");
+
+  const double diagonal = mesh.bounds().diagonal();
+  // Relative tolerances square and cube the diagonal; past ~1e100 that overflows.
+  if (!(diagonal < 1e100))
+    throw Error(ErrorCode::kUnsupportedMesh, source + ": bounding-box diagonal " + std::to_string(diagonal) + " is too large");
+  if (options.weldToleranceRel >= 0.0) {
+    result.weldToleranceAbs = options.weldToleranceRel * diagonal;
+    if (!std::isfinite(result.weldToleranceAbs))
+      throw Error(ErrorCode::kInvalidArgument, "weldToleranceRel " + std::to_string(options.weldToleranceRel) + " is too large");
+    const WeldResult weld = weldVertices(mesh, result.weldToleranceAbs);
+    result.weldedVertexCount = weld.mergedCount;
+  }
+
+  result.report = validateMesh(mesh);
+  try {
+    throwIfUnusable(result.report);
+  } catch (const Error& e) {
+    throw Error(e.code(), source + ": " + e.what());
+  }
+  if (options.orientOutward && result.report.insideOut()) {
+    flipOrientation(mesh);
+    result.flipped = true;
+    result.report = validateMesh(mesh);
+  }
+  result.warnings.reserve(result.warnings.size() + result.report.issues.size() + 2);
+  for (const MeshIssue& issue : result.report.issues) result.warnings.push_back(issue.message);
+  if (result.flipped) result.warnings.push_back("the mesh was inside-out: every triangle was flipped");
+  if (ignoredPrimitives > 0)
+    result.warnings.push_back(std::to_string(ignoredPrimitives) + " points/lines in the file were ignored");
+  return result;
+}
+
+// The checks Assimp needs before it sees the bytes (see text_index_check.h).
 LoadedMesh convertScene(const aiScene* scene, const CapturedLog& log, const std::string& source,
                         const MeshLoadOptions& options) {
   LoadedMesh result;
@@ -232,48 +281,26 @@ LoadedMesh convertScene(const aiScene* scene, const CapturedLog& log, const std:
     }
   }
 
-  result.importedVertexCount = mesh.vertexCount();
-  if (mesh.triangles.empty())
-    throw Error(ErrorCode::kNoTriangles, source + ": no triangles (" + std::to_string(mesh.vertexCount()) + " vertices, " +
-                                             std::to_string(ignoredPrimitives) + " points/lines)");
-
-  const double diagonal = mesh.bounds().diagonal();
-  // Relative tolerances square and cube the diagonal; past ~1e100 that overflows.
-  if (!(diagonal < 1e100))
-    throw Error(ErrorCode::kUnsupportedMesh, source + ": bounding-box diagonal " + std::to_string(diagonal) + " is too large");
-  if (options.weldToleranceRel >= 0.0) {
-    result.weldToleranceAbs = options.weldToleranceRel * diagonal;
-    if (!std::isfinite(result.weldToleranceAbs))
-      throw Error(ErrorCode::kInvalidArgument, "weldToleranceRel " + std::to_string(options.weldToleranceRel) + " is too large");
-    const WeldResult weld = weldVertices(mesh, result.weldToleranceAbs);
-    result.weldedVertexCount = weld.mergedCount;
-  }
-
-  result.report = validateMesh(mesh);
-  try {
-    throwIfUnusable(result.report);
-  } catch (const Error& e) {
-    throw Error(e.code(), source + ": " + e.what());
-  }
-  if (options.orientOutward && result.report.insideOut()) {
-    flipOrientation(mesh);
-    result.flipped = true;
-    result.report = validateMesh(mesh);
-  }
-  result.warnings.reserve(result.warnings.size() + result.report.issues.size() + 2);
-  for (const MeshIssue& issue : result.report.issues) result.warnings.push_back(issue.message);
-  if (result.flipped) result.warnings.push_back("the mesh was inside-out: every triangle was flipped");
-  if (ignoredPrimitives > 0)
-    result.warnings.push_back(std::to_string(ignoredPrimitives) + " points/lines in the file were ignored");
-  return result;
+  return finishMesh(std::move(result), ignoredPrimitives, source, options);
 }
 
-// The checks Assimp needs before it sees the bytes (see text_index_check.h).
-void checkText(std::string_view text, std::string_view format, const std::string& source) {
+void checkText(std::string_view text, const std::string& source) {
   if (auto problem = detail::findPlyHeaderProblem(text)) throw Error(ErrorCode::kParseError, source + ": " + *problem);
-  if (format == "off")
-    if (auto bad = detail::findBadOffFace(text))
-      throw Error(bad->indexOutOfRange ? ErrorCode::kIndexOutOfRange : ErrorCode::kParseError, source + ": " + bad->message);
+}
+
+// OFF goes to our own reader (off_reader.h): by name, or by content when the name says nothing
+// Assimp would act on (Assimp sniffs "off" in the first bytes of files it cannot place).
+bool useOffReader(std::string_view format, std::string_view head) {
+  if (format == "off") return true;
+  const bool knownToAssimp = format == "obj" || format == "stl" || format == "ply" || format == "gltf" || format == "glb";
+  return !knownToAssimp && detail::looksLikeOff(head);
+}
+
+LoadedMesh loadOff(std::string_view text, const std::string& source, const MeshLoadOptions& options) {
+  detail::OffContent content = detail::readOff(text, source);
+  LoadedMesh result;
+  result.mesh = std::move(content.mesh);
+  return finishMesh(std::move(result), content.ignoredPrimitives, source, options);
 }
 
 void checkOptions(const MeshLoadOptions& options) {
@@ -301,8 +328,8 @@ LoadedMesh loadMesh(const std::filesystem::path& path, const MeshLoadOptions& op
   }
   std::string format = lowercase(path.extension().string());
   if (!format.empty()) format.erase(0, 1);
-  // The text of OBJ, OFF and PLY files is needed for the checks of text_index_check.h. Assimp
-  // sniffs PLY content whatever the extension, so every file's first bytes are looked at.
+  // The text of OBJ, OFF and PLY files is needed (text_index_check.h, off_reader.h). Assimp
+  // sniffs content whatever the extension, so every file's first bytes are looked at.
   std::string text;
   if (format == "obj" || format == "off" || format == "ply") {
     text = readWholeFile(path);
@@ -311,10 +338,12 @@ LoadedMesh loadMesh(const std::filesystem::path& path, const MeshLoadOptions& op
     if (std::FILE* file = std::fopen(path.c_str(), "rb")) {
       const std::size_t n = std::fread(head, 1, sizeof head, file);
       std::fclose(file);
-      if (detail::looksLikePly(std::string_view(head, n))) text = readWholeFile(path);
+      const std::string_view headText(head, n);
+      if (detail::looksLikePly(headText) || useOffReader(format, headText)) text = readWholeFile(path);
     }
   }
-  checkText(text, format, source);
+  if (useOffReader(format, text)) return loadOff(text, source, options);
+  checkText(text, source);
 
   Assimp::Importer importer;
   CapturedLog log;
@@ -338,7 +367,8 @@ LoadedMesh loadMeshFromMemory(std::span<const std::byte> bytes, std::string_view
   const std::string source = "<memory:" + format + ">";
   if (bytes.empty()) throw Error(ErrorCode::kEmptyFile, source + " is empty (0 bytes)");
   const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-  checkText(text, format, source);
+  if (useOffReader(format, text)) return loadOff(text, source, options);
+  checkText(text, source);
 
   Assimp::Importer importer;
   CapturedLog log;

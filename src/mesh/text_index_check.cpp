@@ -43,63 +43,6 @@ std::optional<long long> parseInteger(std::string_view token) {
 
 }  // namespace
 
-std::optional<OffProblem> findBadOffFace(std::string_view text) {
-  enum class Stage { kHeader, kCounts, kVertices, kFaces, kDone } stage = Stage::kHeader;
-  long long vertexCount = 0, faceCount = 0, verticesSeen = 0, facesSeen = 0;
-  std::optional<OffProblem> result;
-  forEachTokenLine(text, [&](std::size_t line, const std::vector<std::string_view>& tokens) {
-    std::size_t first = 0;
-    if (stage == Stage::kHeader) {
-      std::string_view keyword = tokens[0];
-      // Accept the optional ST, C, N prefixes in that order; 4OFF / nOFF change the layout.
-      if (keyword.starts_with("ST")) keyword.remove_prefix(2);
-      if (keyword.starts_with("C")) keyword.remove_prefix(1);
-      if (keyword.starts_with("N")) keyword.remove_prefix(1);
-      if (keyword != "OFF") {
-        stage = Stage::kDone;
-        return false;
-      }
-      stage = Stage::kCounts;
-      if (tokens.size() == 1) return true;
-      first = 1;  // counts on the header line
-    }
-    if (stage == Stage::kCounts) {
-      if (tokens.size() < first + 2) return false;
-      auto v = parseInteger(tokens[first]);
-      auto f = parseInteger(tokens[first + 1]);
-      if (!v || !f || *v < 0 || *f < 0) return false;
-      vertexCount = *v;
-      faceCount = *f;
-      stage = vertexCount > 0 ? Stage::kVertices : Stage::kFaces;
-      return faceCount > 0;
-    }
-    if (stage == Stage::kVertices) {
-      if (++verticesSeen == vertexCount) stage = Stage::kFaces;
-      return true;
-    }
-    // Stage::kFaces
-    auto n = parseInteger(tokens[0]);
-    if (n && *n <= 0) {
-      result = OffProblem{false, "line " + std::to_string(line) + ": face " + std::to_string(facesSeen) + " lists " +
-                                     std::to_string(*n) + " vertices"};
-      return false;
-    }
-    if (!n || tokens.size() < std::size_t(*n) + 1) return false;
-    for (long long k = 1; k <= *n; ++k) {
-      auto index = parseInteger(tokens[std::size_t(k)]);
-      if (!index) return false;
-      if (*index < 0 || *index >= vertexCount) {
-        result = OffProblem{true, "line " + std::to_string(line) + ": face " + std::to_string(facesSeen) +
-                                      ": vertex index " + std::to_string(*index) +
-                                      (*index < 0 ? " is negative" : " >= vertex count " + std::to_string(vertexCount))};
-        return false;
-      }
-    }
-    return ++facesSeen < faceCount;
-  });
-  return result;
-}
-
 std::optional<std::string> findBadObjIndex(std::string_view text) {
   long long totalVertices = 0;
   forEachTokenLine(text, [&](std::size_t, const std::vector<std::string_view>& tokens) {
