@@ -76,8 +76,8 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree) : mesh_(std::mo
 CollisionBody CollisionBody::fromBake(const BakeContents& bake) {
   CollisionBody body(bake.mesh, bake.sphereTree);
   body.name_ = bake.sourceName;
-  // The closest feature map and contact tree sections are picked up here once BakeContents
-  // carries them (see the report to the lead in docs/narrow-phase.md).
+  if (bake.closestFeatureMap) body.setClosestFeatureMap(*bake.closestFeatureMap);
+  // The contact tree is picked up here once BakeContents carries its section.
   return body;
 }
 

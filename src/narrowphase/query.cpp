@@ -585,12 +585,15 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
   return complete;
 }
 
+// How a bake gets the section a model needs (apps/clod/cmd_bake.cpp).
+constexpr const char* kCfmOption = "'clod bake', which adds closest feature maps by default (--stacks sets their size)";
+constexpr const char* kContactTreeOption = "'clod bake --contact-tree'";
+
 void throwMissing(const CollisionBody& body, const char* which, const char* what, const char* model,
                   const char* option) {
   throw Error(ErrorCode::kBakeMissingSection, std::string("body ") + which +
                                                   (body.name().empty() ? "" : " ('" + body.name() + "')") + " has no " +
-                                                  what + ", which the " + model + " model needs (bake with " + option +
-                                                  ")");
+                                                  what + ", which the " + model + " model needs (bake with " + option + ")");
 }
 
 void checkSettings(const QuerySettings& s) {
@@ -649,12 +652,12 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
   const ContactModel model = settings.model;
   if (model == ContactModel::kCfm || model == ContactModel::kAverage) {
     const char* name = model == ContactModel::kCfm ? "cfm" : "average";
-    if (!a.hasClosestFeatureMap()) throwMissing(a, "A", "closest feature map", name, "--cfm");
-    if (!b.hasClosestFeatureMap()) throwMissing(b, "B", "closest feature map", name, "--cfm");
+    if (!a.hasClosestFeatureMap()) throwMissing(a, "A", "closest feature map", name, kCfmOption);
+    if (!b.hasClosestFeatureMap()) throwMissing(b, "B", "closest feature map", name, kCfmOption);
   }
   if (model == ContactModel::kContactTree) {
-    if (!a.hasContactTree()) throwMissing(a, "A", "contact tree", "contact-tree", "--contact-tree");
-    if (!b.hasContactTree()) throwMissing(b, "B", "contact tree", "contact-tree", "--contact-tree");
+    if (!a.hasContactTree()) throwMissing(a, "A", "contact tree", "contact-tree", kContactTreeOption);
+    if (!b.hasContactTree()) throwMissing(b, "B", "contact tree", "contact-tree", kContactTreeOption);
   }
 
   QueryScratch::Impl& s = scratch.impl();

@@ -381,7 +381,7 @@ TEST(NarrowPhaseModels, MissingSectionsAndBadSettingsThrow) {
       ADD_FAILURE() << contactModelName(model) << " did not throw";
     } catch (const Error& e) {
       EXPECT_EQ(e.code(), ErrorCode::kBakeMissingSection);
-      EXPECT_NE(std::string(e.what()).find("bake with --"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("bake with 'clod bake"), std::string::npos) << e.what();
     }
   }
   EXPECT_NO_THROW(queryContacts(bare, poseA, bare, Pose{}, settingsFor(ContactModel::kDos, 10)));
