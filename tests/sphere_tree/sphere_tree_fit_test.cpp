@@ -149,8 +149,11 @@ TEST_P(ClosedMeshFit, MedialFitsTighterThanOctreeOnEveryLevelBelowTheRoot) {
   for (std::size_t l = 1; l < 5; ++l) {
     EXPECT_LT(medial[l].fitMean, octree[l].fitMean)
         << "level " << l << ": medial " << medial[l].spheres << " spheres, octree " << octree[l].spheres;
-    RecordProperty("level" + std::to_string(l) + "_fit_max_medial_vs_octree",
-                   std::to_string(medial[l].fitMax) + " vs " + std::to_string(octree[l].fitMax));
+    // The issue asks for the mean at least and aims for the max too; with the default settings
+    // the medial builder wins both on these meshes, so the full-scale run holds it to that.
+    if (!test::sanitizerScale()) {
+      EXPECT_LT(medial[l].fitMax, octree[l].fitMax) << "level " << l;
+    }
   }
 }
 
