@@ -91,7 +91,7 @@ inline constexpr std::uint32_t kMaxListedIssues = 20;
 /// indices (kIndexOutOfRange), no triangles (kNoTriangles), every triangle degenerate
 /// (kAllTrianglesDegenerate). Warnings: open, non-manifold edges/vertices, degenerate or
 /// duplicate triangles, unreferenced vertices, several components, inconsistent orientation,
-/// inside-out. Complexity: O(V + T log T) time, O(V + T) memory.
+/// inside-out, flat (zero extent along an axis, or a closed mesh enclosing zero volume). Complexity: O(V + T log T) time, O(V + T) memory.
 MeshReport validateMesh(const TriangleMesh& mesh);
 
 /// Throws clod::Error for the first fatal finding of `report` (in the order non-finite vertex,

@@ -103,6 +103,16 @@ MeshReport validateMesh(const TriangleMesh& mesh) {
     warn(plural(r.degenerateTriangles, "degenerate (zero-area) triangle", "degenerate (zero-area) triangles") +
          ", first: triangle " + std::to_string(firstDegenerate));
 
+  // --- flat: all vertices in an axis-aligned plane (or line); the mesh encloses nothing ---
+  if (diagonal > 0.0) {
+    const Vec3 extent = r.bounds.extent();
+    for (int axis = 0; axis < 3; ++axis)
+      if (extent[axis] == 0.0) {
+        warn(std::string("the mesh is flat: zero extent along ") + "xyz"[axis]);
+        break;
+      }
+  }
+
   // --- duplicates: sort each triangle's corner set, then the list ---
   {
     std::vector<std::pair<Triangle, std::uint32_t>> sorted(r.triangleCount);

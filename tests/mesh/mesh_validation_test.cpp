@@ -195,6 +195,9 @@ TEST(ValidateMesh, FlatSquareLoadsAsOpenNotFatal) {
   const MeshReport r = requireValidMesh(mesh);
   EXPECT_EQ(r.boundaryEdges, 4u);
   EXPECT_EQ(r.degenerateTriangles, 0u);
+  bool flatWarning = false;
+  for (const MeshIssue& issue : r.issues) flatWarning |= issue.message == "the mesh is flat: zero extent along z";
+  EXPECT_TRUE(flatWarning);
 }
 
 // Random small meshes over a tiny vertex pool produce every kind of topological defect at once;
