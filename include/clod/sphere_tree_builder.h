@@ -70,7 +70,8 @@ struct SphereTreeSettings {
 /// Cost: octree O(T * depth) clipping plus Welzl per cell; medial adds O(S log S) for the
 /// Delaunay of S samples and O(P * branching) k-means per level for P pieces.
 /// Throws clod::Error(kInvalidArgument) for out-of-range settings (the message names the
-/// setting), and kUnsupportedMesh if qhull fails on the samples.
+/// setting). Flat meshes (no volume, so no medial axis) build too: the medial builder then
+/// clusters the surface itself.
 SphereTree buildSphereTree(const MeshDistance& mesh, const SphereTreeSettings& settings);
 
 /// Fit of one level: for every sphere, the greatest distance from its surface to the

@@ -29,8 +29,8 @@ SurfaceSamples sampleSurface(const TriangleMesh& mesh, std::uint32_t target, std
 /// Fills poleCenter / poleRadius from the Delaunay tetrahedralisation of the samples.
 /// A Voronoi vertex counts as interior when the outward normals of its four samples point away
 /// from it on balance (sum of the signs of (centre - sample) . normal < 0); this needs only a
-/// consistently oriented surface, so it also works for open meshes. Throws clod::Error
-/// (kUnsupportedMesh) when qhull fails, with qhull's message.
+/// consistently oriented surface, so it also works for open meshes. If qhull cannot
+/// tetrahedralise the samples (all in one plane: a flat mesh), no sample gets a pole.
 void computeInnerPoles(SurfaceSamples& samples, const Aabb& bounds);
 
 /// Uniform grid over sample positions for nearest-sample queries.

@@ -70,6 +70,14 @@ TEST(PrimitiveSphereTrees, BothBuildersCoverBoxesIcospheresAndCylinders) {
   }
 }
 
+TEST(PrimitiveSphereTrees, FlatMeshesWithoutVolumeAreCovered) {
+  // All samples in one plane: qhull cannot tetrahedralise them, and there is no medial axis.
+  TriangleMesh square;
+  square.vertices = {Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(2, 1, 0), Vec3(0, 1, 0), Vec3(1, 0.5, 0)};
+  square.triangles = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+  checkBothBuilders(square, 2000);
+}
+
 TEST(PrimitiveSphereTrees, DegenerateTrianglesAreAssignedAndCovered) {
   // A box plus a zero-area sliver triangle (three collinear points) sticking out of it.
   TriangleMesh mesh = makeBox(Vec3(1, 1, 1));
