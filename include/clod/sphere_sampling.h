@@ -75,7 +75,7 @@ SamplingScheme parseSamplingScheme(std::string_view name);
 /// Largest accepted resolution per scheme (stacks for the polar schemes, subdivision frequency
 /// for geodesic, N_side for HEALPix, sample count for Fibonacci): 1024, 1024, 64, 256, 16384.
 /// Chosen so that a sampling stays below ~1.1 M samples and the candidate grids of geodesic and
-/// Fibonacci build in about a second.
+/// Fibonacci build in well under a second.
 int maxSamplingResolution(SamplingScheme scheme) noexcept;
 
 /// Progressive refinement (paper section 5, Table 1): a sphere `level` levels below the root
@@ -106,8 +106,8 @@ class SphereSampling {
 public:
   /// Builds `scheme` at `resolution` (stacks S for the polar schemes, frequency f for geodesic,
   /// N_side for HEALPix, sample count for Fibonacci). Cost: O(samples) for ring schemes;
-  /// O(samples^2) for geodesic (~samples^2 / 2) and Fibonacci (~4 samples^2): their candidate
-  /// grids, built in parallel with TBB. Throws clod::Error(kInvalidArgument) if resolution
+  /// O(samples^1.5) for the candidate grid of geodesic and Fibonacci (parallel with TBB), plus
+  /// O(samples) octant lists for geodesic. Throws clod::Error(kInvalidArgument) if resolution
   /// is outside [1, maxSamplingResolution(scheme)].
   static SphereSampling build(SamplingScheme scheme, int resolution);
 

@@ -26,25 +26,27 @@ constexpr double kAngleSlack = 1e-7;
 
 double angleBetween(const Vec3& a, const Vec3& b) { return std::acos(std::clamp(a.dot(b), -1.0, 1.0)); }
 
-int octantOf(const Vec3& u) { return (u.x() < 0.0 ? 1 : 0) | (u.y() < 0.0 ? 2 : 0) | (u.z() < 0.0 ? 4 : 0); }
-
 }  // namespace
 
 void SphereSampling::buildCandidateGrid() {
-  // With octant lists (geodesic) a cell only needs to look at its octant's list: the list holds
-  // every sample that is nearest to some direction of the octant. Otherwise: all samples.
-  std::vector<std::uint32_t> allSamples;
-  if (octantStart_.empty()) {
-    allSamples.resize(size());
-    for (std::uint32_t i = 0; i < size(); ++i) allSamples[i] = i;
-  }
-  auto sourceList = [&](int octant) -> std::pair<const std::uint32_t*, const std::uint32_t*> {
-    if (octantStart_.empty()) return {allSamples.data(), allSamples.data() + allSamples.size()};
-    return {octantSamples_.data() + octantStart_[octant], octantSamples_.data() + octantStart_[octant + 1]};
+  // Samples sorted by z. The angle between two directions is at least the difference of their
+  // polar angles, so every sample within angle w of a direction of polar angle phi has z in
+  // [cos(phi + w), cos(phi - w)]: each cell scans a z window of O(sqrt(n)) samples, not all n.
+  std::vector<std::uint32_t> byZ(size());
+  for (std::uint32_t i = 0; i < size(); ++i) byZ[i] = i;
+  std::sort(byZ.begin(), byZ.end(), [&](std::uint32_t a, std::uint32_t b) { return z_[a] < z_[b] || (z_[a] == z_[b] && a < b); });
+  std::vector<double> sortedZ(size());
+  for (std::uint32_t i = 0; i < size(); ++i) sortedZ[i] = z_[byZ[i]];
+  auto window = [&](double phi, double w) {
+    const double zLow = std::cos(std::min(M_PI, phi + w)) - 1e-12;
+    const double zHigh = std::cos(std::max(0.0, phi - w)) + 1e-12;
+    const auto first = std::lower_bound(sortedZ.begin(), sortedZ.end(), zLow) - sortedZ.begin();
+    const auto last = std::upper_bound(sortedZ.begin(), sortedZ.end(), zHigh) - sortedZ.begin();
+    return std::pair<const std::uint32_t*, const std::uint32_t*>{byZ.data() + first, byZ.data() + last};
   };
+  const double spacing = std::sqrt(4.0 * M_PI / size());  // typical distance between samples
 
-  // Cube-map grid with about 4 cells per sample, so each cell's list stays short. Even side:
-  // the planes x = 0, y = 0, z = 0 fall on cell boundaries, so every cell lies in one octant.
+  // Cube-map grid with about 4 cells per sample, so each cell's list stays short.
   const auto side = static_cast<std::uint32_t>(2 * std::max(1, static_cast<int>(std::ceil(std::sqrt(size() / 6.0)))));
   gridSide_ = side;
   const std::uint32_t cellCount = 6 * side * side;
@@ -70,15 +72,26 @@ void SphereSampling::buildCandidateGrid() {
       for (int corner = 0; corner < 4; ++corner) {
         cellRadius = std::max(cellRadius, angleBetween(centre, cellPoint(coord(ci + (corner & 1)), coord(cj + (corner >> 1)))));
       }
-      const auto [first, last] = sourceList(octantOf(centre));
+      const double phi = std::atan2(std::hypot(centre.x(), centre.y()), centre.z());
+      // d_min(centre): scan a window that usually holds the nearest sample; if the best found is
+      // farther than the window's half-width, rescan with that distance, which is then exact.
+      double window0 = 2.0 * cellRadius + 2.0 * spacing + kAngleSlack;
       double bestDot = -2.0;
-      for (const std::uint32_t* s = first; s != last; ++s) bestDot = std::max(bestDot, direction(*s).dot(centre));
+      for (int pass = 0; pass < 2; ++pass) {
+        const auto [first, last] = window(phi, window0);
+        for (const std::uint32_t* s = first; s != last; ++s) bestDot = std::max(bestDot, direction(*s).dot(centre));
+        const double bestAngle = std::acos(std::clamp(bestDot, -1.0, 1.0));
+        if (bestAngle <= window0) break;
+        window0 = bestAngle + kAngleSlack;
+      }
       const double limit = std::acos(std::clamp(bestDot, -1.0, 1.0)) + 2.0 * cellRadius + kAngleSlack;
       const double cosLimit = std::cos(std::min(limit, M_PI));
       auto& list = cellLists[cell];
+      const auto [first, last] = window(phi, limit);
       for (const std::uint32_t* s = first; s != last; ++s) {
         if (direction(*s).dot(centre) >= cosLimit) list.push_back(*s);
       }
+      std::sort(list.begin(), list.end());
     }
   });
   cellStart_.reserve(cellCount + 1);
