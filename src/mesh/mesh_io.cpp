@@ -286,6 +286,7 @@ LoadedMesh convertScene(const aiScene* scene, const CapturedLog& log, const std:
 
 void checkText(std::string_view text, const std::string& source) {
   if (auto problem = detail::findPlyHeaderProblem(text)) throw Error(ErrorCode::kParseError, source + ": " + *problem);
+  if (auto problem = detail::findGlbHeaderProblem(text)) throw Error(ErrorCode::kParseError, source + ": " + *problem);
 }
 
 // OFF goes to our own reader (off_reader.h): by name, or by content when the name says nothing
@@ -328,10 +329,10 @@ LoadedMesh loadMesh(const std::filesystem::path& path, const MeshLoadOptions& op
   }
   std::string format = lowercase(path.extension().string());
   if (!format.empty()) format.erase(0, 1);
-  // The text of OBJ, OFF and PLY files is needed (text_index_check.h, off_reader.h). Assimp
+  // The bytes of OBJ, OFF, PLY and GLB files are needed (text_index_check.h, off_reader.h). Assimp
   // sniffs content whatever the extension, so every file's first bytes are looked at.
   std::string text;
-  if (format == "obj" || format == "off" || format == "ply") {
+  if (format == "obj" || format == "off" || format == "ply" || format == "glb") {
     text = readWholeFile(path);
   } else {
     char head[64] = {};
@@ -339,7 +340,8 @@ LoadedMesh loadMesh(const std::filesystem::path& path, const MeshLoadOptions& op
       const std::size_t n = std::fread(head, 1, sizeof head, file);
       std::fclose(file);
       const std::string_view headText(head, n);
-      if (detail::looksLikePly(headText) || useOffReader(format, headText)) text = readWholeFile(path);
+      if (detail::looksLikePly(headText) || detail::looksLikeGlb(headText) || useOffReader(format, headText))
+        text = readWholeFile(path);
     }
   }
   if (useOffReader(format, text)) return loadOff(text, source, options);

@@ -1,6 +1,7 @@
 #include "text_index_check.h"
 
 #include <charconv>
+#include <cstring>
 #include <vector>
 
 namespace clod::detail {
@@ -92,6 +93,31 @@ std::optional<std::string> findPlyHeaderProblem(std::string_view text) {
     pos = end + 1;
   }
   return "PLY header has no 'end_header' line";
+}
+
+bool looksLikeGlb(std::string_view bytes) { return bytes.size() >= 4 && bytes.substr(0, 4) == "glTF"; }
+
+std::optional<std::string> findGlbHeaderProblem(std::string_view bytes) {
+  if (!looksLikeGlb(bytes)) return std::nullopt;
+  // Little-endian u32 fields (glTF 2.0 spec, "Binary glTF Layout"): magic, version, length, then
+  // chunks of (length, type, data).
+  auto u32 = [&](std::size_t offset) {
+    const auto* p = reinterpret_cast<const unsigned char*>(bytes.data() + offset);
+    return std::uint64_t(p[0]) | std::uint64_t(p[1]) << 8 | std::uint64_t(p[2]) << 16 | std::uint64_t(p[3]) << 24;
+  };
+  if (bytes.size() < 12) return "GLB header is truncated (" + std::to_string(bytes.size()) + " bytes)";
+  const std::uint64_t declared = u32(8);
+  if (declared > bytes.size())
+    return "GLB header declares " + std::to_string(declared) + " bytes, the file has " + std::to_string(bytes.size());
+  std::uint64_t offset = 12;
+  for (int chunk = 0; offset + 8 <= declared; ++chunk) {
+    const std::uint64_t length = u32(std::size_t(offset));
+    if (offset + 8 + length > declared)
+      return "GLB chunk " + std::to_string(chunk) + " declares " + std::to_string(length) + " bytes, only " +
+             std::to_string(declared - offset - 8) + " remain";
+    offset += 8 + length;
+  }
+  return std::nullopt;
 }
 
 }  // namespace clod::detail

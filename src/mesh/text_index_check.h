@@ -2,7 +2,9 @@
 // Checks on the raw text of OBJ and PLY files, run next to Assimp because Assimp either rejects
 // an out-of-range index without saying where (OBJ: "vertex index out of range") or never
 // returns (PLY: a header without an `end_header` line loops forever in Assimp 5.2.5).
-// (OFF is not read by Assimp at all: see off_reader.h.)
+// (OFF is not read by Assimp at all: see off_reader.h.) The binary glTF header check lives here
+// too: Assimp allocates and clears whatever chunk length a GLB header claims (1 GiB for a
+// 788-byte file found by fuzz_mesh_load) before it notices the file is shorter.
 // These scanners read only what they need; they are not loaders, and on anything they do not
 // understand they return std::nullopt and leave the verdict to Assimp.
 
@@ -26,5 +28,12 @@ bool looksLikePly(std::string_view text);
 /// `end_header` (trailing spaces and CR allowed), which would hang Assimp's PLY reader; nullopt
 /// otherwise. O(size).
 std::optional<std::string> findPlyHeaderProblem(std::string_view text);
+
+/// True when the bytes start with the GLB magic "glTF".
+bool looksLikeGlb(std::string_view bytes);
+
+/// For GLB content (looksLikeGlb), a message when the declared total length or a chunk length
+/// does not fit in the bytes actually there; nullopt otherwise. O(number of chunks).
+std::optional<std::string> findGlbHeaderProblem(std::string_view bytes);
 
 }  // namespace clod::detail

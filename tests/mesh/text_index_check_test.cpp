@@ -21,5 +21,21 @@ TEST(FindPlyHeaderProblem, RequiresAnEndHeaderLine) {
   EXPECT_FALSE(findPlyHeaderProblem("solid not a ply\n"));
 }
 
+TEST(FindGlbHeaderProblem, ChecksDeclaredLengthsAgainstTheBytes) {
+  auto header = [](std::uint32_t total, std::uint32_t chunk) {
+    std::string bytes = "glTF";
+    for (std::uint32_t v : {2u, total, chunk, 0x4E4F534Au})
+      for (int k = 0; k < 4; ++k) bytes.push_back(char((v >> (8 * k)) & 0xff));
+    return bytes;
+  };
+  std::string ok = header(24, 4) + "{}  ";
+  EXPECT_FALSE(findGlbHeaderProblem(ok));
+  std::string longTotal = header(1000, 4) + "{}  ";
+  EXPECT_EQ(findGlbHeaderProblem(longTotal), "GLB header declares 1000 bytes, the file has 24");
+  std::string longChunk = header(24, 400) + "{}  ";
+  EXPECT_EQ(findGlbHeaderProblem(longChunk), "GLB chunk 0 declares 400 bytes, only 4 remain");
+  EXPECT_FALSE(findGlbHeaderProblem("solid x"));
+}
+
 }  // namespace
 }  // namespace clod::detail
