@@ -6,6 +6,11 @@
 
 #include <tbb/parallel_for.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#include <xmmintrin.h>
+#endif
+
 #include "clod/error.h"
 #include "clod/proximity.h"
 #include "pseudonormals.h"
@@ -139,56 +144,74 @@ float floatAbove(double x) {
 // Best-first descent with a fixed-size stack: children are pushed farthest first so the nearest
 // is expanded next, and anything whose box is farther than the best triangle so far is dropped.
 //
-// Exactness with float boxes: the boxes contain the triangles (rounded outward), p is bracketed
-// by [pLo, pHi] in float, so each per-axis gap computed from them is at most the true gap up to
-// one float rounding (relative 2^-24, or 2^-149 absolute in the subnormal range). The squared
-// distance is then formed in double and shrunk by a margin covering those roundings, so a box
-// is dropped only if it truly cannot hold a closer point: the answer equals brute force.
+// Exactness with float boxes: the boxes contain the triangles (rounded outward) and p is
+// bracketed by [pLo, pHi] in float, so each per-axis gap computed from them is at most the
+// true gap up to one rounding. The float squared distance then carries at most a few
+// roundings (relative 2^-24 each, or 2^-149 absolute in the subnormal range); it is shrunk by
+// a margin covering them and compared with the best squared distance rounded up to float. So a
+// box is dropped only if it truly cannot hold a closer point: the answer equals brute force.
+// (Float overflow gives +inf on both sides of the comparison, which keeps the box: safe.)
 MeshDistance::Impl::Nearest MeshDistance::Impl::nearest(const Vec3& p) const {
   struct Entry {
-    double lowerBound;
+    float lowerBound;
     std::uint32_t child;
     std::uint32_t count;
   };
-  constexpr double kShrink = 1.0 - 1.0 / (1 << 20);
-  constexpr double kSubnormalSlack = 1e-82;
+  constexpr float kShrink = 1.0f - 1.0f / (1 << 20);
+  constexpr float kSubnormalSlack = 1e-44f;
   Entry stack[3 * detail::TriangleBvh::kMaxDepth + 4];
   int top = 0;
-  const float pLo[3] = {floatBelow(p.x()), floatBelow(p.y()), floatBelow(p.z())};
-  const float pHi[3] = {floatAbove(p.x()), floatAbove(p.y()), floatAbove(p.z())};
   const Bvh4Node* nodes = bvh.nodes().data();
 
+  const float pLoS[3] = {floatBelow(p.x()), floatBelow(p.y()), floatBelow(p.z())};
+  const float pHiS[3] = {floatAbove(p.x()), floatAbove(p.y()), floatAbove(p.z())};
+#if defined(__SSE2__)
+  const __m128 pLoX = _mm_set1_ps(pLoS[0]), pLoY = _mm_set1_ps(pLoS[1]), pLoZ = _mm_set1_ps(pLoS[2]);
+  const __m128 pHiX = _mm_set1_ps(pHiS[0]), pHiY = _mm_set1_ps(pHiS[1]), pHiZ = _mm_set1_ps(pHiS[2]);
+  const __m128 zero = _mm_setzero_ps(), shrink = _mm_set1_ps(kShrink), slack = _mm_set1_ps(kSubnormalSlack);
+#endif
+
   Nearest best{{p, std::numeric_limits<double>::infinity(), FeatureType::kFace, 0}, 0xffffffffu};
-  stack[top++] = {0.0, 0, 0};
+  float bestBound = std::numeric_limits<float>::infinity();  // best squared distance, rounded up
+  stack[top++] = {0.0f, 0, 0};
   while (top > 0) {
     const Entry entry = stack[--top];
-    if (entry.lowerBound > best.point.distanceSquared) continue;
+    if (entry.lowerBound > bestBound) continue;
     if (entry.count > 0) {
       for (std::uint32_t i = entry.child; i < entry.child + entry.count; ++i) {
         const PackedTriangle& tri = packed[i];
+        // (A per-triangle float box cull here measured 10-20% slower: the exact test is cheap.)
         const TrianglePoint tp = tri.thin ? detail::closestPointOnThinTriangle(p, tri.a, tri.b, tri.c)
                                           : detail::closestPointOnRegularTriangle(p, tri.a, tri.b, tri.c);
         if (tp.distanceSquared < best.point.distanceSquared || best.position == 0xffffffffu) {
           best = {tp, i};
+          bestBound = floatAbove(tp.distanceSquared);
         }
       }
       continue;
     }
     const Bvh4Node& node = nodes[entry.child];
-    double bound[4];
+    alignas(16) float bound[4];
+#if defined(__SSE2__)
+    const __m128 dx = _mm_max_ps(_mm_max_ps(_mm_sub_ps(_mm_load_ps(node.minX), pHiX), _mm_sub_ps(pLoX, _mm_load_ps(node.maxX))), zero);
+    const __m128 dy = _mm_max_ps(_mm_max_ps(_mm_sub_ps(_mm_load_ps(node.minY), pHiY), _mm_sub_ps(pLoY, _mm_load_ps(node.maxY))), zero);
+    const __m128 dz = _mm_max_ps(_mm_max_ps(_mm_sub_ps(_mm_load_ps(node.minZ), pHiZ), _mm_sub_ps(pLoZ, _mm_load_ps(node.maxZ))), zero);
+    const __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    _mm_store_ps(bound, _mm_sub_ps(_mm_mul_ps(d2, shrink), slack));
+#else
     for (int s = 0; s < 4; ++s) {
-      const float dx = std::max(std::max(node.minX[s] - pHi[0], pLo[0] - node.maxX[s]), 0.0f);
-      const float dy = std::max(std::max(node.minY[s] - pHi[1], pLo[1] - node.maxY[s]), 0.0f);
-      const float dz = std::max(std::max(node.minZ[s] - pHi[2], pLo[2] - node.maxZ[s]), 0.0f);
-      const double x = dx, y = dy, z = dz;
-      bound[s] = (x * x + y * y + z * z) * kShrink - kSubnormalSlack;
+      const float dx = std::max(std::max(node.minX[s] - pHiS[0], pLoS[0] - node.maxX[s]), 0.0f);
+      const float dy = std::max(std::max(node.minY[s] - pHiS[1], pLoS[1] - node.maxY[s]), 0.0f);
+      const float dz = std::max(std::max(node.minZ[s] - pHiS[2], pLoS[2] - node.maxZ[s]), 0.0f);
+      bound[s] = (dx * dx + dy * dy + dz * dz) * kShrink - kSubnormalSlack;
     }
+#endif
     // Insertion-sort the surviving slots by bound, largest first, then push in that order.
     Entry children[4];
     int n = 0;
     for (int s = 0; s < 4; ++s) {
-      if (node.child[s] == Bvh4Node::kEmpty || bound[s] > best.point.distanceSquared) continue;
-      Entry e{bound[s], node.child[s], node.count[s]};
+      if (node.child[s] == Bvh4Node::kEmpty || bound[s] > bestBound) continue;
+      const Entry e{bound[s], node.child[s], node.count[s]};
       int j = n++;
       while (j > 0 && children[j - 1].lowerBound < e.lowerBound) {
         children[j] = children[j - 1];
@@ -196,7 +219,17 @@ MeshDistance::Impl::Nearest MeshDistance::Impl::nearest(const Vec3& p) const {
       }
       children[j] = e;
     }
-    for (int i = 0; i < n; ++i) stack[top++] = children[i];
+    for (int i = 0; i < n; ++i) {
+      stack[top++] = children[i];
+#if defined(__SSE2__) && !defined(NO_PREFETCH)
+      // Queries are bound by memory latency (profiled: the first touch of a node or a
+      // triangle dominates), so start fetching every child that survived the cull now.
+      const char* address = children[i].count > 0 ? reinterpret_cast<const char*>(&packed[children[i].child])
+                                                  : reinterpret_cast<const char*>(&nodes[children[i].child]);
+      const std::size_t bytes = children[i].count > 0 ? children[i].count * sizeof(PackedTriangle) : sizeof(Bvh4Node);
+      for (std::size_t offset = 0; offset < bytes; offset += 64) _mm_prefetch(address + offset, _MM_HINT_T0);
+#endif
+    }
   }
   return best;
 }
