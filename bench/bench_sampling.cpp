@@ -3,6 +3,7 @@
 //   BM_Sampling_Nearest/<scheme>/<stacks>             exact default lookup (nearest())
 //   BM_Sampling_NearestPaperFormula/<scheme>/<stacks>  the paper's plain rounding (ring schemes)
 //   BM_Sampling_NearestQuadrant/geodesic/<stacks>      the paper's geodesic retrieval
+// Schemes: polar, adaptive-polar, geodesic, healpix, fibonacci.
 //   BM_Sampling_NearestLinearScan/<scheme>/<stacks>    argmax over all samples
 // <stacks> is the paper's stack count; geodesic and HEALPix use the resolution with the closest
 // sample count (samplingResolutionForStacks), reported in the counters with the sample count.
@@ -69,9 +70,12 @@ void registerLookups() {
       if (scheme == SamplingScheme::kGeodesic && clod::samplingResolutionForStacks(scheme, stacks) > 32) continue;
       const std::string suffix = "/" + name + "/" + std::to_string(stacks);
       benchmark::RegisterBenchmark(("BM_Sampling_Nearest" + suffix).c_str(), runLookup, scheme, stacks, Method::kNearest);
-      if (scheme != SamplingScheme::kGeodesic) {
+      const bool ringScheme = scheme == SamplingScheme::kPolar || scheme == SamplingScheme::kAdaptivePolar ||
+                              scheme == SamplingScheme::kHealpix;
+      if (ringScheme) {
         benchmark::RegisterBenchmark(("BM_Sampling_NearestPaperFormula" + suffix).c_str(), runLookup, scheme, stacks, Method::kPaperFormula);
-      } else {
+      }
+      if (scheme == SamplingScheme::kGeodesic) {
         benchmark::RegisterBenchmark(("BM_Sampling_NearestQuadrant" + suffix).c_str(), runLookup, scheme, stacks, Method::kQuadrant);
       }
       if (stacks <= 40) {
