@@ -125,7 +125,7 @@ struct QueryScratch::Impl {
   std::vector<std::uint8_t> pairDone;
   std::vector<std::array<std::uint32_t, 2>> volumePairs;
   std::vector<std::uint32_t> clippers;
-  std::vector<Vec3> poly, polyTmp, insideA, insideB;
+  std::vector<Vec3> poly, polyTmp;
   std::vector<Contact> raw;
   std::vector<ContactPoint> sampled;
   std::vector<double> manifold;
@@ -422,8 +422,10 @@ Contact toWorld(const Contact& local, const Pose& xfWorldFromA) {
 // both halves the discretisation error). The part of a triangle inside the other body is taken
 // as the triangle clipped by the inner half-spaces of the other body's triangles it intersects:
 // exact where the other surface is locally convex, an approximation where it is concave, and
-// triangles lying wholly inside the other body (no intersection) are not counted. Depth is the
-// extent of those inside parts along N: max over B's parts of N.x - min over A's parts of N.x.
+// triangles lying wholly inside the other body (no intersection) are not counted. Depth: the
+// distance along N between the area centroids of the two inside surfaces -- the penetration for
+// flat contacts, the mean depth (half the lens thickness) for two spheres; an extent along N
+// (max - min) would grow with N's tilt times the patch width.
 // For a box resting on a box this gives the face normal (tilted by ~depth/width from the thin
 // side strips) and the penetration; for two spheres, the centre line and the lens thickness.
 void clipByHalfSpaces(const Vec3& p0, const Vec3& p1, const Vec3& p2, const TriangleMesh& other,
@@ -447,6 +449,15 @@ void clipByHalfSpaces(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Tria
   }
 }
 
+// Adds the area-weighted centroid (moved by xf) and the area of a convex polygon.
+void accumulateCentroid(const std::vector<Vec3>& poly, const Pose& xf, Vec3& weighted, double& area) {
+  for (std::size_t i = 1; i + 1 < poly.size(); ++i) {
+    const double a = 0.5 * (poly[i] - poly[0]).cross(poly[i + 1] - poly[0]).norm();
+    weighted += a * xf.apply((poly[0] + poly[i] + poly[i + 1]) / 3.0);
+    area += a;
+  }
+}
+
 Vec3 polygonAreaVector(const std::vector<Vec3>& poly) {
   Vec3 sum = Vec3::Zero();
   for (std::size_t i = 1; i + 1 < poly.size(); ++i) sum += (poly[i] - poly[0]).cross(poly[i + 1] - poly[0]);
@@ -457,9 +468,10 @@ void penetrationVolumeNormal(const TriangleMesh& ma, const TriangleMesh& mb, con
                              QueryScratch::Impl& s, Vec3& normal, double& depth) {
   auto& pairs = s.volumePairs;
   if (pairs.empty()) return;
-  s.insideA.clear();
-  s.insideB.clear();
+  depth = 0.0;
   Vec3 sum = Vec3::Zero();
+  Vec3 centroidA = Vec3::Zero(), centroidB = Vec3::Zero();
+  double areaA = 0.0, areaB = 0.0;
   const Pose xfBFromA = xfAFromB.inverse();
   // A's triangles, each clipped by the B triangles it meets (pairs sorted by A's triangle).
   std::sort(pairs.begin(), pairs.end());
@@ -470,7 +482,7 @@ void penetrationVolumeNormal(const TriangleMesh& ma, const TriangleMesh& mb, con
     const std::uint32_t t = pairs[i][0];
     clipByHalfSpaces(ma.corner(t, 0), ma.corner(t, 1), ma.corner(t, 2), mb, xfAFromB, s.clippers, s.poly, s.polyTmp);
     sum -= polygonAreaVector(s.poly);  // its area vector is n_A * area (counter-clockwise)
-    s.insideA.insert(s.insideA.end(), s.poly.begin(), s.poly.end());
+    accumulateCentroid(s.poly, Pose{}, centroidA, areaA);
     i = j;
   }
   // B's triangles, clipped by the A triangles they meet, in B's frame, then moved to A's.
@@ -482,17 +494,12 @@ void penetrationVolumeNormal(const TriangleMesh& ma, const TriangleMesh& mb, con
     const std::uint32_t t = pairs[i][1];
     clipByHalfSpaces(mb.corner(t, 0), mb.corner(t, 1), mb.corner(t, 2), ma, xfBFromA, s.clippers, s.poly, s.polyTmp);
     sum += xfAFromB.rotation * polygonAreaVector(s.poly);
-    for (const Vec3& p : s.poly) s.insideB.push_back(xfAFromB.apply(p));
+    accumulateCentroid(s.poly, xfAFromB, centroidB, areaB);
     i = j;
   }
   const double len = sum.norm();
-  if (!(len > 0.0)) return;
-  normal = sum / len;
-  double maxB = -std::numeric_limits<double>::infinity();
-  double minA = std::numeric_limits<double>::infinity();
-  for (const Vec3& p : s.insideB) maxB = std::max(maxB, normal.dot(p));
-  for (const Vec3& p : s.insideA) minA = std::min(minA, normal.dot(p));
-  depth = (s.insideA.empty() || s.insideB.empty()) ? 0.0 : std::max(0.0, maxB - minA);
+  if (len > 0.0) normal = sum / len;
+  if (areaA > 0.0 && areaB > 0.0) depth = std::max(0.0, normal.dot(centroidB / areaB - centroidA / areaA));
 }
 
 // Returns true if every frontier pair got its triangle tests.

@@ -1,0 +1,20 @@
+# FCL and Bullet peers for bench_narrowphase (optional; found in cmake/ClodDependencies.cmake).
+if(TARGET bench_narrowphase)
+  if(TARGET fcl)
+    target_link_libraries(bench_narrowphase PRIVATE fcl)
+    target_compile_definitions(bench_narrowphase PRIVATE CLOD_BENCH_HAVE_FCL=1)
+    message(STATUS "bench_narrowphase: comparing with FCL")
+  else()
+    message(STATUS "bench_narrowphase: FCL not found, comparison skipped")
+  endif()
+  if(BULLET_FOUND)
+    # Debian's Bullet is built in double precision for the -float64 libraries only; the plain
+    # libraries are single precision, which is what BULLET_LIBRARIES names.
+    target_include_directories(bench_narrowphase SYSTEM PRIVATE ${BULLET_INCLUDE_DIRS})
+    target_link_libraries(bench_narrowphase PRIVATE ${BULLET_LIBRARIES})
+    target_compile_definitions(bench_narrowphase PRIVATE CLOD_BENCH_HAVE_BULLET=1)
+    message(STATUS "bench_narrowphase: comparing with Bullet GImpact")
+  else()
+    message(STATUS "bench_narrowphase: Bullet not found, comparison skipped")
+  endif()
+endif()
