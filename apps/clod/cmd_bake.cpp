@@ -5,20 +5,27 @@
 // sphere-tree level, root first, each with spheres, fit_mean, fit_max in units of the
 // bounding-box diagonal), build_seconds, file_bytes; plus extras (mesh_hash, vertices,
 // triangles, sign_method, method, branching, depth, per-stage seconds, sections, warnings).
+// Closest feature maps (--sampling, --stacks; default adaptive-polar, 10 stacks, the paper's):
+// each levels entry also has samples_per_sphere_max / samples_per_sphere_min (sample points of
+// that level's spheres' maps, the paper's Table 1 "samples"), stacks, stored_normals_min/max and
+// single_normal_spheres; top level: sampling, stacks, min_stacks, normal_codec, cfm_normals.
 // Nothing is printed until the file is written, so an error leaves stdout empty, and a failed
 // bake leaves neither OUT.clod nor a temporary file behind.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <memory>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "cli_util.h"
 #include "clod/atomic_file.h"
 #include "clod/bake.h"
 #include "clod/error.h"
 #include "clod/mesh_io.h"
+#include "clod/sphere_sampling.h"
 #include "command.h"
 
 namespace clod::cli {
@@ -31,8 +38,19 @@ struct BakeOptions {
   std::uint32_t branching = SphereTreeSettings{}.branching;
   std::uint32_t levels = SphereTreeSettings{}.depth;
   std::uint32_t medialSamples = SphereTreeSettings{}.medialSamples;
+  // Closest feature maps (--sampling, --stacks, --min-stacks, --normal-codec).
+  std::string sampling = std::string(samplingSchemeName(ClosestFeatureMapSettings{}.scheme));
+  int stacks = ClosestFeatureMapSettings{}.rootStacks;
+  int minStacks = ClosestFeatureMapSettings{}.minStacks;
+  std::string normalCodec = std::string(normalCodecName(ClosestFeatureMapSettings{}.codec));
   bool json = false;
 };
+
+std::vector<std::string> samplingSchemeNames() {
+  std::vector<std::string> names;
+  for (SamplingScheme scheme : allSamplingSchemes()) names.emplace_back(samplingSchemeName(scheme));
+  return names;
+}
 
 std::string hex64(std::uint64_t value) {
   char text[24];
@@ -47,6 +65,10 @@ int runBake(const BakeOptions& options) {
   settings.sphereTree.depth = options.levels;
   settings.sphereTree.medialSamples = options.medialSamples;
   settings.sourceName = std::filesystem::path(options.meshPath).filename().string();
+  settings.closestFeatureMap.scheme = parseSamplingScheme(options.sampling);
+  settings.closestFeatureMap.rootStacks = options.stacks;
+  settings.closestFeatureMap.minStacks = std::min(options.minStacks, options.stacks);
+  settings.closestFeatureMap.codec = parseNormalCodec(options.normalCodec);
 
   LoadedMesh loaded = loadMesh(options.meshPath);
   const BakeResult result = bakeMesh(loaded.mesh, settings);
@@ -75,7 +97,25 @@ int runBake(const BakeOptions& options) {
     nlohmann::json levels = nlohmann::json::array();
     for (std::uint32_t l = 0; l < result.levelFit.size(); ++l) {
       const SphereTreeLevelFit& fit = result.levelFit[l];
-      levels.push_back({{"level", l}, {"spheres", fit.spheres}, {"fit_mean", fit.fitMean}, {"fit_max", fit.fitMax}});
+      nlohmann::json level = {{"level", l}, {"spheres", fit.spheres}, {"fit_mean", fit.fitMean}, {"fit_max", fit.fitMax}};
+      if (contents.closestFeatureMap) {
+        // samples_per_sphere_*: sample points of the sphere's map (the paper's Table 1 "samples");
+        // stored_normals_*: normals actually stored (1 for a single-normal sphere).
+        const ClosestFeatureMap& cfm = *contents.closestFeatureMap;
+        std::uint32_t storedMin = ~0u, storedMax = 0, single = 0;
+        for (std::uint32_t i = tree.levelBegin(l); i < tree.levelEnd(l); ++i) {
+          storedMin = std::min(storedMin, cfm.storedNormalCount(i));
+          storedMax = std::max(storedMax, cfm.storedNormalCount(i));
+          single += cfm.isSingleNormal(i) ? 1u : 0u;
+        }
+        level["stacks"] = cfm.stacksAtTreeLevel(l);
+        level["samples_per_sphere_max"] = cfm.samplesAtLevel(l);
+        level["samples_per_sphere_min"] = cfm.samplesAtLevel(l);
+        level["stored_normals_min"] = storedMin;
+        level["stored_normals_max"] = storedMax;
+        level["single_normal_spheres"] = single;
+      }
+      levels.push_back(level);
     }
     out["levels"] = levels;
     out["spheres"] = tree.sphereCount();
@@ -83,6 +123,14 @@ int runBake(const BakeOptions& options) {
     out["distance_seconds"] = result.timings.distanceSeconds;
     out["sphere_tree_seconds"] = result.timings.sphereTreeSeconds;
     out["fit_seconds"] = result.timings.fitSeconds;
+    out["cfm_seconds"] = result.timings.cfmSeconds;
+    if (contents.closestFeatureMap) {
+      out["sampling"] = samplingSchemeName(contents.closestFeatureMap->settings().scheme);
+      out["stacks"] = contents.closestFeatureMap->settings().rootStacks;
+      out["min_stacks"] = contents.closestFeatureMap->settings().minStacks;
+      out["normal_codec"] = normalCodecName(contents.closestFeatureMap->settings().codec);
+      out["cfm_normals"] = contents.closestFeatureMap->poolSize();
+    }
     out["write_seconds"] = writeSeconds;
     out["file_bytes"] = bytes.size();
     nlohmann::json sections = nlohmann::json::array();
@@ -107,7 +155,11 @@ int runBake(const BakeOptions& options) {
   for (std::uint32_t l = 0; l < result.levelFit.size(); ++l) {
     const SphereTreeLevelFit& fit = result.levelFit[l];
     text << "    level " << l << ": " << fit.spheres << " spheres, fit mean " << fit.fitMean << ", max " << fit.fitMax
-         << " (of the bbox diagonal)\n";
+         << " (of the bbox diagonal)";
+    if (contents.closestFeatureMap) {
+      text << ", " << contents.closestFeatureMap->samplesAtLevel(l) << " CFM samples per sphere";
+    }
+    text << "\n";
   }
   std::cout << text.str();
   return 0;
@@ -129,6 +181,19 @@ const CommandRegistration kRegistration("bake", [](CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--medial-samples", options->medialSamples,
                   "Surface samples for the medial-axis builder, 100..2000000")
+      ->capture_default_str();
+  sub->add_option("--sampling", options->sampling,
+                  "Closest feature map sampling scheme (sphere_sampling.h)")
+      ->check(CLI::IsMember(samplingSchemeNames()))
+      ->capture_default_str();
+  sub->add_option("--stacks", options->stacks, "Closest feature map stacks at the root, halved per level (1..)")
+      ->check(CLI::Range(1, maxSamplingResolution(SamplingScheme::kPolar)))
+      ->capture_default_str();
+  sub->add_option("--min-stacks", options->minStacks, "Fewest stacks on any level (capped at --stacks)")
+      ->check(CLI::Range(1, maxSamplingResolution(SamplingScheme::kPolar)))
+      ->capture_default_str();
+  sub->add_option("--normal-codec", options->normalCodec, "Encoding of stored normals: oct16 or oct32")
+      ->check(CLI::IsMember({"oct16", "oct32"}))
       ->capture_default_str();
   sub->add_flag("--json", options->json,
                 "Print one JSON object: levels[{level, spheres, fit_mean, fit_max}] (fit in units of the "

@@ -15,6 +15,7 @@
 //             neighbour_definition} for the other neighbour definitions
 //   paper_formula[] {scheme, stacks, samples, queries, misses, miss_rate, max_excess_deg,
 //             mean_excess_deg}: how often the paper's plain lookup formula misses the nearest sample
+#include <cstdlib>
 #include <filesystem>
 #include <functional>
 #include <iomanip>
@@ -30,6 +31,12 @@
 #include "clod/sampling_statistics.h"
 #include "clod/sphere_sampling.h"
 #include "command.h"
+#include "clod/bake.h"
+#include "clod/closest_feature_map.h"
+#include "clod/mesh_io.h"
+#include "clod/normal_accuracy.h"
+#include "clod/primitives.h"
+#include "clod/proximity.h"
 
 namespace clod::cli {
 namespace {
@@ -40,6 +47,8 @@ struct ExperimentOptions {
   std::string outDir;
   std::string neighbours = std::string(neighbourDefinitionName(NeighbourDefinition::kNearest4));
   long queries = 100000;
+  /// normals, sizes: where the shared meshes are (default: $CLOD_MESH_DIR, else ../shared/data/meshes).
+  std::string meshDir;
 };
 
 struct ExperimentResult {
@@ -157,11 +166,170 @@ ExperimentResult runSampling(const ExperimentOptions& options) {
   return result;
 }
 
+std::filesystem::path sharedMeshPath(const ExperimentOptions& options, const std::string& name) {
+  std::string dir = options.meshDir;
+  if (dir.empty()) {
+    const char* env = std::getenv("CLOD_MESH_DIR");
+    dir = env != nullptr && *env != '\0' ? env : "../shared/data/meshes";
+  }
+  return std::filesystem::path(dir) / name;
+}
+
+// normals: contact-normal accuracy per sphere-tree level and model (the point of the CFM paper;
+// distribution and definitions in normal_accuracy.h and docs/closest-feature-maps.md). JSON keys:
+//   meshes[] {mesh, triangles, sign_method, levels[] {level, spheres, points, attempts,
+//             models[] {model, median_deg, p95_deg, mean_deg, max_deg}}}
+//   settings {points_per_level, near_surface_fraction, seed, sphere_tree}
+// Model names: dos, average, cfm-<scheme>-<stacks> (oct16), cfm-adaptive-polar-10-oct32.
+ExperimentResult runNormals(const ExperimentOptions& options) {
+  ExperimentResult result;
+  nlohmann::json& doc = result.document;
+  doc["experiment"] = "normals";
+  NormalAccuracySettings settings;
+  settings.pointsPerLevel = 2000;
+  const SphereTreeSettings treeSettings;  // the bake default
+  doc["settings"] = {{"points_per_level", settings.pointsPerLevel},
+                     {"near_surface_fraction", settings.nearSurfaceFraction},
+                     {"seed", settings.seed},
+                     {"sphere_tree", {{"method", sphereTreeMethodName(treeSettings.method)},
+                                      {"branching", treeSettings.branching},
+                                      {"depth", treeSettings.depth}}}};
+  std::ostringstream csv, text;
+  csv << "mesh,level,spheres,points,model,median_deg,p95_deg,mean_deg,max_deg\n" << std::setprecision(6);
+  text << std::fixed << std::setprecision(2);
+  doc["meshes"] = nlohmann::json::array();
+  const char* meshNames[] = {"box", "spot.obj", "cow.obj", "fandisk.obj", "rocker-arm.obj", "bunny-1500.obj", "teapot.obj", "suzanne.obj"};
+  for (const char* name : meshNames) {
+    const std::string meshName = name;
+    TriangleMesh mesh = meshName == "box" ? makeBox(Vec3(1.0, 0.6, 0.3))
+                                          : loadMesh(sharedMeshPath(options, meshName)).mesh;
+    const MeshDistance distance(std::move(mesh));
+    const SphereTree tree = buildSphereTree(distance, treeSettings);
+    std::vector<ClosestFeatureMap> maps;
+    std::vector<std::string> labels;
+    for (int stacks : {10, 16}) {
+      for (SamplingScheme scheme : allSamplingSchemes()) {
+        ClosestFeatureMapSettings s;
+        s.scheme = scheme;
+        s.rootStacks = stacks;
+        maps.push_back(buildClosestFeatureMap(distance, tree, s));
+        labels.push_back("cfm-" + std::string(samplingSchemeName(scheme)) + "-" + std::to_string(stacks));
+      }
+    }
+    ClosestFeatureMapSettings wide;
+    wide.codec = NormalCodec::kOctahedral32;
+    maps.push_back(buildClosestFeatureMap(distance, tree, wide));
+    labels.push_back("cfm-adaptive-polar-10-oct32");
+    std::vector<NormalAccuracyCandidate> candidates = {{"dos", ContactNormalModel::kDingliana, &maps[0]},
+                                                       {"average", ContactNormalModel::kAverage, &maps[0]}};
+    for (std::size_t k = 0; k < maps.size(); ++k) candidates.push_back({labels[k], ContactNormalModel::kClosestFeatureMap, &maps[k]});
+    const std::vector<NormalAccuracyLevel> levels = measureNormalAccuracy(distance, tree, candidates, settings);
+
+    nlohmann::json meshDoc = {{"mesh", meshName}, {"triangles", distance.mesh().triangleCount()},
+                              {"sign_method", signMethodName(distance.signMethod())}};
+    meshDoc["levels"] = nlohmann::json::array();
+    text << meshName << " (" << distance.mesh().triangleCount() << " triangles): median / p95 angle error, degrees\n";
+    text << "  level  points       dos   average  cfm-ap-10  cfm-hp-10  cfm-ap-16  cfm-hp-16\n";
+    for (const NormalAccuracyLevel& level : levels) {
+      nlohmann::json models = nlohmann::json::array();
+      for (std::size_t k = 0; k < candidates.size(); ++k) {
+        const AngleErrorStats& st = level.models[k];
+        models.push_back({{"model", candidates[k].label}, {"median_deg", st.medianDeg}, {"p95_deg", st.p95Deg},
+                          {"mean_deg", st.meanDeg}, {"max_deg", st.maxDeg}});
+        csv << meshName << "," << level.level << "," << level.spheres << "," << level.points << "," << candidates[k].label
+            << "," << st.medianDeg << "," << st.p95Deg << "," << st.meanDeg << "," << st.maxDeg << "\n";
+      }
+      meshDoc["levels"].push_back({{"level", level.level}, {"spheres", level.spheres}, {"points", level.points},
+                                   {"attempts", level.attempts}, {"models", models}});
+      // Columns: dos, average, adaptive polar and HEALPix at 10 and 16 stacks.
+      text << "  " << std::setw(5) << level.level << std::setw(8) << level.points;
+      std::vector<std::size_t> columns;
+      for (const char* label : {"dos", "average", "cfm-adaptive-polar-10", "cfm-healpix-10", "cfm-adaptive-polar-16", "cfm-healpix-16"}) {
+        for (std::size_t k = 0; k < candidates.size(); ++k) {
+          if (candidates[k].label == label) columns.push_back(k);
+        }
+      }
+      for (std::size_t k : columns) {
+        std::ostringstream cell;
+        cell << std::fixed << std::setprecision(1) << level.models[k].medianDeg << "/" << level.models[k].p95Deg;
+        text << " " << std::setw(k < 2 ? 10 : 11) << cell.str();
+      }
+      text << "\n";
+    }
+    doc["meshes"].push_back(meshDoc);
+  }
+  result.csv = csv.str();
+  result.text = text.str();
+  return result;
+}
+
+// sizes: the CFM paper's Table 1 - root and leaf samples at 10 and 16 stacks and bake file sizes
+// for a cube and bunny-1500 (sphere-tree of the paper's three levels: depth 2, 8-ary, medial;
+// stacks halved per level down to 1 as in the paper, min_stacks 1; 16-bit normals). JSON keys:
+//   rows[] {mesh, triangles, stacks, root_samples, leaf_samples, paper_root_samples,
+//           paper_leaf_samples, spheres, stored_normals, single_normal_spheres, file_bytes,
+//           cfm_bytes, sphere_tree_bytes, mesh_bytes, paper_file_size_k}
+ExperimentResult runSizes(const ExperimentOptions& options) {
+  ExperimentResult result;
+  nlohmann::json& doc = result.document;
+  doc["experiment"] = "sizes";
+  doc["paper"] = "Giang & O'Sullivan 2006, Table 1 (file also held the sphere-tree)";
+  doc["rows"] = nlohmann::json::array();
+  std::ostringstream csv, text;
+  csv << "mesh,triangles,stacks,root_samples,leaf_samples,paper_root_samples,paper_leaf_samples,file_bytes,cfm_bytes,sphere_tree_bytes,mesh_bytes,paper_file_size_k\n";
+  text << "Table 1: samples per sphere (root / leaf) and bake file size\n";
+  struct Row { const char* mesh; int stacks; std::uint32_t paperRoot, paperLeaf, paperK; };
+  const Row rows[] = {{"cube", 10, 65, 3, 112}, {"bunny-1500.obj", 10, 65, 3, 130},
+                      {"cube", 16, 167, 11, 345}, {"bunny-1500.obj", 16, 167, 11, 415}};
+  for (const Row& row : rows) {
+    const std::string meshName = row.mesh;
+    const TriangleMesh mesh = meshName == "cube" ? makeBox(Vec3(1.0, 1.0, 1.0))
+                                                 : loadMesh(sharedMeshPath(options, meshName)).mesh;
+    BakeSettings settings;
+    settings.sphereTree.depth = 2;
+    settings.measureFit = false;
+    settings.closestFeatureMap.rootStacks = row.stacks;
+    settings.closestFeatureMap.minStacks = 1;
+    const BakeResult baked = bakeMesh(mesh, settings);
+    const std::vector<std::byte> bytes = encodeBake(baked.contents);
+    const BakeFileReader file(bytes);
+    std::uint64_t cfmBytes = 0, treeBytes = 0, meshBytes = 0;
+    for (const BakeSectionEntry& e : file.entries()) {
+      if (e.tag == kBakeCfmTag) cfmBytes = e.size;
+      if (e.tag == kBakeSphereTreeTag) treeBytes = e.size;
+      if (e.tag == kBakeMeshTag) meshBytes = e.size;
+    }
+    const ClosestFeatureMap& cfm = *baked.contents.closestFeatureMap;
+    const std::uint32_t leafLevel = cfm.levelCount() - 1;
+    std::uint32_t single = 0;
+    for (std::uint32_t i = 0; i < cfm.sphereCount(); ++i) single += cfm.isSingleNormal(i) ? 1u : 0u;
+    doc["rows"].push_back({{"mesh", meshName}, {"triangles", mesh.triangleCount()}, {"stacks", row.stacks},
+                           {"root_samples", cfm.samplesAtLevel(0)}, {"leaf_samples", cfm.samplesAtLevel(leafLevel)},
+                           {"paper_root_samples", row.paperRoot}, {"paper_leaf_samples", row.paperLeaf},
+                           {"spheres", cfm.sphereCount()}, {"stored_normals", cfm.poolSize()},
+                           {"single_normal_spheres", single}, {"file_bytes", bytes.size()}, {"cfm_bytes", cfmBytes},
+                           {"sphere_tree_bytes", treeBytes}, {"mesh_bytes", meshBytes}, {"paper_file_size_k", row.paperK}});
+    csv << meshName << "," << mesh.triangleCount() << "," << row.stacks << "," << cfm.samplesAtLevel(0) << ","
+        << cfm.samplesAtLevel(leafLevel) << "," << row.paperRoot << "," << row.paperLeaf << "," << bytes.size() << ","
+        << cfmBytes << "," << treeBytes << "," << meshBytes << "," << row.paperK << "\n";
+    text << "  " << std::left << std::setw(16) << meshName << std::right << " stacks " << std::setw(2) << row.stacks
+         << ": root " << cfm.samplesAtLevel(0) << " (paper " << row.paperRoot << "), leaf " << cfm.samplesAtLevel(leafLevel)
+         << " (paper " << row.paperLeaf << "), file " << bytes.size() << " bytes (CFM " << cfmBytes << ", tree "
+         << treeBytes << ", mesh " << meshBytes << "; paper " << row.paperK << "k)\n";
+  }
+  doc["note"] = "the paper's 167 root samples at 16 stacks are not reproduced by the adaptive-polar rule (163)";
+  result.csv = csv.str();
+  result.text = text.str();
+  return result;
+}
+
 ExperimentResult runAll(const ExperimentOptions& options);
 
 // Later experiments (fidelity, landing, flat-contact, sizes, retrieval) plug in here.
 constexpr Experiment kExperiments[] = {
     {"sampling", "CFM paper Tables 1-2: sample counts, neighbour-distance spread, lookup accuracy", runSampling},
+    {"normals", "contact-normal angle error per sphere-tree level: D&O, average, CFM per scheme (shared meshes)", runNormals},
+    {"sizes", "CFM paper Table 1: root/leaf samples at 10 and 16 stacks and bake file sizes (cube, bunny-1500)", runSizes},
     {"all", "every experiment above", runAll},
 };
 
@@ -219,6 +387,8 @@ const CommandRegistration kRegistration("experiment", [](CLI::App& app) {
   sub->add_option("-o,--output", options->outDir, "Also write NAME.json and NAME.csv into this directory (created if needed)");
   sub->add_option("--neighbours", options->neighbours, "sampling: neighbour definition of the rows (nearest-1, nearest-4, nearest-6)")
       ->capture_default_str();
+  sub->add_option("--mesh-dir", options->meshDir,
+                  "normals, sizes: directory of the shared test meshes (default $CLOD_MESH_DIR or ../shared/data/meshes)");
   sub->add_option("--queries", options->queries, "sampling: random directions per lookup-accuracy row")->capture_default_str();
   return [options] { return runExperiment(*options); };
 });

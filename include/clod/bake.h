@@ -16,11 +16,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "clod/bake_file.h"
+#include "clod/closest_feature_map.h"
 #include "clod/error.h"
 #include "clod/mesh.h"
 #include "clod/proximity.h"
@@ -34,6 +36,9 @@ inline constexpr BakeSectionTag kBakeMeshTag = makeBakeSectionTag("MESH");
 inline constexpr std::uint32_t kBakeMeshVersion = 1;
 inline constexpr BakeSectionTag kBakeSphereTreeTag = makeBakeSectionTag("STRE");
 inline constexpr std::uint32_t kBakeSphereTreeVersion = 1;
+/// Closest feature maps of the sphere-tree (optional; layout in src/bake/cfm_section.h).
+inline constexpr BakeSectionTag kBakeCfmTag = makeBakeSectionTag("CFMP");
+inline constexpr std::uint32_t kBakeCfmVersion = 1;
 
 /// 64-bit content hash of a mesh, for cache keys and to tie a bake to its mesh: XXH3-64
 /// (seed 0) over the vertex count and triangle count (u64 each), then every vertex coordinate
@@ -56,6 +61,10 @@ struct BakeContents {
   /// The sphere-tree and the settings it was built with. Required ('STRE').
   SphereTree sphereTree;
   SphereTreeSettings sphereTreeSettings;
+
+  /// Closest feature maps of sphereTree (optional, 'CFMP'). Must have been built for
+  /// sphereTree (encodeBake re-checks it with ClosestFeatureMap::fromData: kInvalidArgument).
+  std::optional<ClosestFeatureMap> closestFeatureMap;
 };
 
 /// Encodes contents as a complete bake file. Deterministic: equal contents give identical
@@ -100,6 +109,9 @@ struct BakeSettings {
   bool measureFit = true;
   /// Stored in BakeContents::sourceName.
   std::string sourceName;
+  /// Build the closest feature maps (BakeContents::closestFeatureMap) with these settings.
+  bool buildClosestFeatureMap = true;
+  ClosestFeatureMapSettings closestFeatureMap;
 };
 
 /// Wall-clock seconds per stage of bakeMesh.
@@ -107,7 +119,8 @@ struct BakeTimings {
   double distanceSeconds = 0.0;    ///< building MeshDistance (BVH, topology, pseudonormals)
   double sphereTreeSeconds = 0.0;  ///< buildSphereTree
   double fitSeconds = 0.0;         ///< measureSphereTreeFit (0 if not measured)
-  /// Everything that goes into the file: distanceSeconds + sphereTreeSeconds (+ later sections);
+  double cfmSeconds = 0.0;         ///< buildClosestFeatureMap (0 if not built)
+  /// Everything that goes into the file: distanceSeconds + sphereTreeSeconds + cfmSeconds (+ later sections);
   /// excludes fit measurement.
   double buildSeconds = 0.0;
 };

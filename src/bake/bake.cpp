@@ -13,6 +13,7 @@
 
 #include "clod/atomic_file.h"
 #include "clod/error.h"
+#include "cfm_section.h"
 #include "mesh_section.h"
 #include "sphere_tree_section.h"
 
@@ -41,6 +42,14 @@ std::vector<std::byte> encodeBake(const BakeContents& contents) {
                     detail::encodeMeshSection(contents.mesh, meshContentHash(contents.mesh), contents.sourceName));
   writer.addSection(kBakeSphereTreeTag, kBakeSphereTreeVersion,
                     detail::encodeSphereTreeSection(contents.sphereTree, contents.sphereTreeSettings));
+  if (contents.closestFeatureMap) {
+    try {  // the map must belong to this tree: re-check it as the decoder will
+      ClosestFeatureMap::fromData(contents.closestFeatureMap->data(), contents.sphereTree);
+    } catch (const Error& e) {
+      throw Error(ErrorCode::kInvalidArgument, std::string("encodeBake: ") + e.what());
+    }
+    writer.addSection(kBakeCfmTag, kBakeCfmVersion, detail::encodeCfmSection(*contents.closestFeatureMap));
+  }
   return writer.encode();
 }
 
@@ -58,6 +67,9 @@ BakeContents decodeBake(std::span<const std::byte> bytes) {
         file.section(kBakeSphereTreeTag, kBakeSphereTreeVersion).payload, contents.mesh.triangleCount());
     contents.sphereTree = std::move(tree.tree);
     contents.sphereTreeSettings = tree.settings;
+  }
+  if (const std::optional<BakeSection> cfm = file.findSection(kBakeCfmTag, kBakeCfmVersion)) {
+    contents.closestFeatureMap = detail::decodeCfmSection(cfm->payload, contents.sphereTree);
   }
   return contents;
 }

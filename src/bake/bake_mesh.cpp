@@ -20,7 +20,12 @@ BakeResult bakeMesh(const TriangleMesh& mesh, const BakeSettings& settings) {
   start = std::chrono::steady_clock::now();
   result.contents.sphereTree = buildSphereTree(distance, settings.sphereTree);
   result.timings.sphereTreeSeconds = secondsSince(start);
-  result.timings.buildSeconds = result.timings.distanceSeconds + result.timings.sphereTreeSeconds;
+  if (settings.buildClosestFeatureMap) {
+    start = std::chrono::steady_clock::now();
+    result.contents.closestFeatureMap = buildClosestFeatureMap(distance, result.contents.sphereTree, settings.closestFeatureMap);
+    result.timings.cfmSeconds = secondsSince(start);
+  }
+  result.timings.buildSeconds = result.timings.distanceSeconds + result.timings.sphereTreeSeconds + result.timings.cfmSeconds;
 
   if (settings.measureFit) {
     start = std::chrono::steady_clock::now();
