@@ -105,8 +105,9 @@ struct ClosestFeatureMapData {
   std::vector<std::uint16_t> codes16;
   std::vector<std::uint32_t> codes32;
   /// Per sphere, x y z of the area-weighted mean of its responsible triangles' face normals,
-  /// normalised; (0, 0, 0) when that mean is shorter than 1e-9 (normals cancel) or the sphere
-  /// has no triangles (contact_normal.h then falls back to D&O).
+  /// normalised; (0, 0, 0) when the length of the area-weighted sum is at most 1e-9 times the
+  /// triangles' total area (the normals cancel, e.g. a sphere bounding a closed component) or
+  /// the sphere has no triangles (contact_normal.h then falls back to D&O).
   std::vector<float> averageNormals;
 };
 
@@ -183,7 +184,7 @@ int closestFeatureMapStacks(const ClosestFeatureMapSettings& settings, int level
 /// Builds the map of `tree` over `mesh` (the tree must have been built for this mesh). In
 /// parallel over spheres (TBB); deterministic. Cost: sum over spheres of
 /// (samples of its level) x (its responsible triangles) point-triangle distances, e.g. ~0.1 s
-/// for spot (5,856 triangles, 8-ary, 5 levels, 10 stacks) on one core.
+/// for spot (5,856 triangles, 8-ary, 5 levels, 10 stacks) on 2 cores (docs/benchmarks/cfm.md).
 /// Throws clod::Error(kInvalidArgument) for settings out of range (message names the setting)
 /// or a tree that does not fit the mesh (a triangle index out of range, a sphere without
 /// triangles, inconsistent arrays).
