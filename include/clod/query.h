@@ -34,7 +34,10 @@
 // pairs of those leaves (deduplicated: a triangle may belong to several leaves) are tested for
 // intersection, one test each, in (triangle of A, triangle of B) order. Each intersecting pair
 // gives the end points of its intersection segment (or the corners of the overlap polygon of
-// coplanar triangles) as contacts, with the minimum-penetration face normal of the two triangles
+// coplanar triangles facing each other) as contacts. All of them share one normal, the gradient
+// of the bodies' intersection volume (B's surface inside A minus A's surface inside B, area-
+// weighted normals, each intersecting triangle clipped by the other body's triangles it meets),
+// and one depth, the distance along that normal between the two inside surfaces' centroids
 // (docs/narrow-phase.md). Pairs of the frontier that did not get that far (interrupted) give
 // D&O contacts.
 //
