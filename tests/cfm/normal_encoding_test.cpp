@@ -83,7 +83,7 @@ ErrorStats measure(int count, Encode encode, Decode decode) {
 }
 
 TEST(NormalEncoding, SixteenBitErrorStaysWithinTheAnalyticBound) {
-  const int count = sanitizerRun() ? 200000 : 2000000;
+  const int count = sanitizerRun() ? 50000 : 2000000;
   const ErrorStats e = measure(count, clod::encodeOctahedral16, clod::decodeOctahedral16);
   const double bound = clod::octahedralErrorBound(8);
   std::cout << "[ oct16 ] max " << e.max * 180 / M_PI << " deg, mean " << e.mean * 180 / M_PI
@@ -98,7 +98,7 @@ TEST(NormalEncoding, SixteenBitErrorStaysWithinTheAnalyticBound) {
 }
 
 TEST(NormalEncoding, ThirtyTwoBitErrorStaysWithinTheAnalyticBound) {
-  const int count = sanitizerRun() ? 100000 : 1000000;
+  const int count = sanitizerRun() ? 25000 : 1000000;
   const ErrorStats e = measure(count, clod::encodeOctahedral32, clod::decodeOctahedral32);
   const double bound = clod::octahedralErrorBound(16);
   std::cout << "[ oct32 ] max " << e.max * 180 / M_PI << " deg, mean " << e.mean * 180 / M_PI

@@ -22,8 +22,9 @@ bool sanitizerRun() {
   return scale != nullptr && std::string(scale) == "sanitizer";
 }
 
-// The issue asks for 10^5 random directions per (scheme, resolution); ASan+UBSan runs ~10x slower.
-int randomQueryCount() { return sanitizerRun() ? 10000 : 100000; }
+// The issue asks for 10^5 random directions per (scheme, resolution). Under ASan+UBSan the
+// brute-force oracle over up to 4000 samples dominates; 2000 directions keep it within budget.
+int randomQueryCount() { return sanitizerRun() ? 2000 : 100000; }
 
 Vec3 randomUnit(std::mt19937_64& rng) {
   std::normal_distribution<double> gauss;
@@ -115,7 +116,7 @@ TEST(SphereSamplingNearest, GeodesicCoveringRadiusBoundsTheDistanceToTheNearestS
     const SphereSampling s = SphereSampling::build(SamplingScheme::kGeodesic, f);
     std::mt19937_64 rng(5 + f);
     double worst = 0.0;
-    for (int q = 0; q < randomQueryCount() / 4; ++q) {
+    for (int q = 0; q < 25000; ++q) {  // fixed: the 15% check below needs dense coverage
       const Vec3 u = randomUnit(rng);
       worst = std::max(worst, std::acos(std::min(1.0, bruteForceBestDot(s, u))));
     }
