@@ -51,8 +51,8 @@ struct LoadedMesh {
 /// (kNoTriangles), or only zero-area triangles (kAllTrianglesDegenerate).
 /// Open, non-manifold and flat meshes load, with warnings.
 ///
-/// OFF files (by extension/hint, or content starting with "OFF" under an extension Assimp does
-/// not know) are read by clod's own strict reader, because Assimp 5.2.5's OFF reader repairs
+/// OFF files (by extension/hint, or any content starting with "OFF") are read by clod's own
+/// strict reader, because Assimp 5.2.5's OFF reader repairs
 /// bad indices silently and crashes on some malformed files; polygons are fan-triangulated.
 /// Every other format goes through Assimp.
 ///

@@ -289,12 +289,12 @@ void checkText(std::string_view text, const std::string& source) {
   if (auto problem = detail::findGlbHeaderProblem(text)) throw Error(ErrorCode::kParseError, source + ": " + *problem);
 }
 
-// OFF goes to our own reader (off_reader.h): by name, or by content when the name says nothing
-// Assimp would act on (Assimp sniffs "off" in the first bytes of files it cannot place).
+// OFF goes to our own reader (off_reader.h): by name, or by content whatever the name, because
+// when the reader the name picks rejects the bytes, Assimp sniffs "off" in the first bytes and
+// hands them to its OFF reader anyway (fuzz_mesh_load: OFF bytes with hint "glb" crashed it).
+// No other supported format can start with "off".
 bool useOffReader(std::string_view format, std::string_view head) {
-  if (format == "off") return true;
-  const bool knownToAssimp = format == "obj" || format == "stl" || format == "ply" || format == "gltf" || format == "glb";
-  return !knownToAssimp && detail::looksLikeOff(head);
+  return format == "off" || detail::looksLikeOff(head);
 }
 
 LoadedMesh loadOff(std::string_view text, const std::string& source, const MeshLoadOptions& options) {
