@@ -193,6 +193,8 @@ TEST(LoadMesh, EveryBadFileGivesItsErrorCodeAndNamesTheCulprit) {
       {"face_with_zero_vertices.off", ErrorCode::kParseError, "line 6: face 0: '0' is not a vertex count >= 1"},
       // Assimp allocates and clears the 1 GiB this 788-byte file claims (found by fuzz_mesh_load).
       {"glb_chunk_too_long.glb", ErrorCode::kParseError, "declares 1073742416 bytes"},
+      // OFF bytes under a .glb name: Assimp fell back to its OFF reader and crashed (fuzz).
+      {"off_content_with_glb_name.glb", ErrorCode::kParseError, "vertex 1: expected three numbers"},
   };
   for (const BadCase& c : cases) {
     SCOPED_TRACE(c.file);
