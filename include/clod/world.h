@@ -1,0 +1,146 @@
+#pragma once
+// The rigid-body world: impulse-based dynamics (Mirtich & Canny 1995; Mirtich 1996) solved as
+// sequential impulses with accumulated clamping and warm starting (Catto, "Iterative dynamics
+// with temporal coherence", GDC 2005), with a per-frame collision budget that the world divides
+// among the colliding pairs. docs/dynamics.md explains the choices and their reasons.
+//
+// One step (World::step) of length dt:
+//   1. substeps: n = ceil(max speed * dt / (kTravelFraction * smallest body extent)), at most
+//      WorldSettings::maxSubsteps, so no body moves more than a fraction of the thinnest body's
+//      size per substep (anti-tunnelling by substepping; the narrow phase then sees overlap);
+//   2. per substep: gravity; broad phase (sweep and prune over world boxes of the root spheres);
+//      budget division among the candidate pairs (below); narrow phase (queryContacts) per pair;
+//      velocity solve (normal + 2 friction directions per contact, accumulated impulses clamped,
+//      warm started from the previous substep's contacts of the same pair matched by proximity);
+//      restitution only above WorldSettings::restitutionThreshold; penetration removed by a
+//      separate pseudo-velocity solve (split impulses) that moves positions but never enters the
+//      velocities, so correction adds no kinetic energy; integration (semi-implicit Euler for
+//      positions; angular momentum kept exactly through rotation, see docs/dynamics.md).
+//
+// Budget division (the time-critical part): the candidate pairs are ranked first by how many
+// substeps they have gone without a query (round robin: a starved pair moves to the front), then
+// by priority = approach speed along last contact normal + last deepest depth / dt. Walking down
+// the list, each pair gets share = remaining / pairs left (at least 1 test), and what a pair
+// does not use rolls over to the pairs after it. When the budget is gone, the remaining pairs are
+// not queried this substep: they keep their last contacts (graceful fallback) and are reported
+// as skipped. Each pair keeps a CoherenceCache, so an interrupted pair resumes from the level it
+// reached next time. Hence a substep makes at most max(budget, number of pairs) tests.
+//
+// Determinism: everything runs on one thread in a fixed order; the same scene and settings give
+// bit-identical states on the same build.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "clod/broadphase.h"
+#include "clod/contact.h"
+#include "clod/rigid_body.h"
+
+namespace clod {
+
+/// Body index in the order of World::addBody.
+using BodyId = std::uint32_t;
+
+struct WorldSettings {
+  Vec3 gravity = Vec3(0.0, 0.0, -9.81);  ///< may be zero
+  ContactModel model = ContactModel::kCfm;
+  /// Sphere/triangle tests per substep for all pairs together; 0 = unlimited.
+  std::uint64_t budgetTests = 0;
+  /// Manifold size per pair (QuerySettings::maxContacts), >= 1.
+  std::uint32_t maxContacts = 8;
+  /// Velocity iterations of the sequential-impulse solver (>= 1); position iterations likewise.
+  std::uint32_t velocityIterations = 12;
+  std::uint32_t positionIterations = 4;
+  /// Stop iterating early when no impulse changed by more than this (relative to the largest
+  /// accumulated impulse); 0 = always run every iteration.
+  double convergenceRel = 1e-9;
+  /// Normal approach speeds below this get no restitution (m/s), so resting contact stays at rest.
+  double restitutionThreshold = 0.5;
+  /// Split-impulse penetration correction: fraction of (depth - slop) removed per substep
+  /// (Baumgarte-like factor, in (0, 1]) and the allowed penetration, relative to the smaller
+  /// body's bounding-box diagonal.
+  double correctionFactor = 0.2;
+  double slopRel = 0.002;
+  /// At most this many substeps per step (>= 1).
+  std::uint32_t maxSubsteps = 128;
+  /// Bodies whose centre of mass leaves this box are reported in StepReport::leftBounds
+  /// (once, when they leave) and then frozen (made static) so they cannot run off to infinity.
+  Aabb bounds = Aabb{Vec3::Constant(-1e3), Vec3::Constant(1e3)};
+};
+
+/// Per-pair part of a step's report (last substep's query of the pair).
+struct PairReport {
+  BodyId a = 0, b = 0;
+  std::uint64_t tests = 0;     ///< tests spent on this pair in this step (all substeps)
+  std::uint32_t level = 0;     ///< deepest level reached (QueryResult::maxLevel), last query
+  bool finished = false;       ///< the last query reached the leaves
+  bool skipped = false;        ///< budget gone before its turn in the last substep: old contacts used
+  std::uint32_t contacts = 0;  ///< contacts the solver used in the last substep
+};
+
+/// What one World::step did.
+struct StepReport {
+  std::uint32_t substeps = 0;
+  std::uint64_t candidatePairs = 0;  ///< broad-phase pairs, summed over substeps
+  std::uint64_t testsSpent = 0;      ///< narrow-phase tests, all pairs and substeps
+  std::uint64_t testsBudget = 0;     ///< budgetTests * substeps (0 = unlimited)
+  std::uint64_t pairsSkipped = 0;    ///< pair queries skipped for lack of budget, summed
+  std::uint64_t pairsInterrupted = 0;///< queries that stopped before the leaves, summed
+  std::uint32_t solverIterations = 0;///< velocity iterations used, summed over substeps
+  double narrowPhaseSeconds = 0.0;
+  double solverSeconds = 0.0;
+  std::vector<PairReport> pairs;     ///< pairs with contacts or queries this step, sorted (a, b)
+  std::vector<BodyId> leftBounds;    ///< bodies that left WorldSettings::bounds in this step
+  std::vector<Contact> contacts;     ///< last substep's contacts (world frame) ...
+  std::vector<std::array<BodyId, 2>> contactBodies;  ///< ... and the pair (a, b) of each
+};
+
+class World {
+public:
+  /// Throws clod::Error(kInvalidArgument) naming the setting when one is out of range.
+  explicit World(const WorldSettings& settings = {});
+  ~World();
+  World(World&&) noexcept;
+  World& operator=(World&&) noexcept;
+
+  /// Adds a body; returns its id (0, 1, ...). Throws clod::Error(kInvalidArgument) naming the
+  /// body for a null shape, a non-positive or non-finite mass, a non-positive-definite inertia
+  /// of a dynamic body, restitution outside [0, 1], negative friction, or non-finite state.
+  BodyId addBody(const RigidBodyDesc& desc);
+
+  /// Advances by dt (> 0, finite; else kInvalidArgument). Throws clod::Error(kSimulationDiverged)
+  /// naming the body when a state becomes NaN or infinite (the state is then that of the failed
+  /// substep). Cost: broad phase O(n log n + pairs) + narrow phase (bounded by the budget, see
+  /// the top of this file) + solver O(iterations * contacts) per substep. No allocation once the
+  /// contact and pair counts have stopped growing.
+  const StepReport& step(double dt);
+
+  std::size_t bodyCount() const noexcept;
+  RigidBodyState state(BodyId id) const;  ///< id < bodyCount() (CLOD_ASSERT)
+  const RigidBodyDesc& desc(BodyId id) const;  ///< as added (initial state)
+  BodyType type(BodyId id) const;  ///< current type (a body that left the bounds is kStatic)
+  double mass(BodyId id) const;    ///< 0 for static/kinematic
+  /// Total linear momentum, angular momentum about the world origin, and kinetic energy of the
+  /// dynamic bodies; potential energy -m g.x summed likewise.
+  Vec3 linearMomentum() const;
+  Vec3 angularMomentum() const;
+  double kineticEnergy() const;
+  double potentialEnergy() const;
+  const WorldSettings& settings() const noexcept;
+  /// Changes the budget / model between steps (caches are cleared on a model change).
+  void setBudgetTests(std::uint64_t tests);
+  void setModel(ContactModel model);
+  /// 64-bit hash of every body's state bits (for determinism checks).
+  std::uint64_t stateHash() const;
+
+  struct Impl;
+
+private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace clod

@@ -1,0 +1,531 @@
+// The world: broad phase -> budget division -> narrow phase -> sequential impulses. The design
+// and its reasons are in docs/dynamics.md; the contracts in include/clod/world.h.
+#include "clod/world.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <map>
+
+#include <Eigen/Eigenvalues>
+
+#include "clod/error.h"
+#include "clod/query.h"
+
+namespace clod {
+namespace {
+
+// Fraction of the thinnest body's extent a body may travel per substep. Below 1/2 a body cannot
+// pass through a body as thick as that extent without overlapping it in some substep.
+constexpr double kTravelFraction = 0.25;
+
+bool finite(const Vec3& v) { return v.allFinite(); }
+
+Mat3 worldInverseInertia(const Mat3& invInertiaLocal, const Quat& q) {
+  const Mat3 r = q.toRotationMatrix();
+  return r * invInertiaLocal * r.transpose();
+}
+
+struct Body {
+  RigidBodyDesc desc;
+  BodyType type = BodyType::kDynamic;
+  double invMass = 0.0;
+  Mat3 inertiaLocal = Mat3::Zero();
+  Mat3 invInertiaLocal = Mat3::Zero();
+  Vec3 comLocal = Vec3::Zero();
+  Aabb localBox;         // mesh bounds, mesh coordinates
+  double minExtent = 0;  // smallest side of localBox
+  // State: centre of mass in the world, orientation, velocities.
+  Vec3 x = Vec3::Zero();
+  Quat q = Quat::Identity();
+  Vec3 v = Vec3::Zero();
+  Vec3 w = Vec3::Zero();
+  // Split-impulse pseudo velocities (reset every substep).
+  Vec3 vp = Vec3::Zero();
+  Vec3 wp = Vec3::Zero();
+  Mat3 invInertiaWorld = Mat3::Zero();
+
+  Pose pose() const { return Pose{q, x - q * comLocal}; }
+  Aabb worldBox(double margin) const {
+    const Pose p = pose();
+    const Vec3 c = p.apply(localBox.center());
+    const Mat3 r = p.rotation.toRotationMatrix().cwiseAbs();
+    const Vec3 h = r * (0.5 * localBox.extent()) + Vec3::Constant(margin);
+    return Aabb{c - h, c + h};
+  }
+};
+
+// One contact constraint; accumulated impulses persist for warm starting.
+struct SolverContact {
+  Contact c;
+  Vec3 rA = Vec3::Zero(), rB = Vec3::Zero(), t1 = Vec3::UnitX(), t2 = Vec3::UnitY();
+  double massN = 0, massT1 = 0, massT2 = 0;
+  double targetN = 0;     // restitution target for the normal relative velocity
+  double targetPos = 0;   // pseudo-velocity target (split impulse)
+  double lambdaN = 0, lambdaT1 = 0, lambdaT2 = 0, lambdaP = 0;
+  Vec3 frictionImpulse = Vec3::Zero();  // world-frame tangential impulse, for warm starting
+};
+
+struct PairState {
+  CoherenceCache cache;
+  std::vector<SolverContact> contacts;
+  std::vector<SolverContact> previous;
+  std::uint32_t stale = 0;   // substeps since last query
+  double priority = 0.0;
+  bool seen = false;         // in this substep's broad phase
+};
+
+std::uint64_t pairKey(BodyId a, BodyId b) { return (std::uint64_t(a) << 32) | b; }
+
+void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
+  // Any unit vector orthogonal to n, chosen from the axis least aligned with n (stable).
+  const Vec3 a = std::abs(n.x()) < 0.57735 ? Vec3::UnitX() : (std::abs(n.y()) < 0.57735 ? Vec3::UnitY() : Vec3::UnitZ());
+  t1 = n.cross(a).normalized();
+  t2 = n.cross(t1);
+}
+
+}  // namespace
+
+struct World::Impl {
+  WorldSettings settings;
+  std::vector<Body> bodies;
+  std::map<std::uint64_t, PairState> pairs;  // ordered: deterministic iteration
+  StepReport report;
+  std::vector<Aabb> boxes;
+  std::vector<std::uint8_t> active;
+  std::vector<BodyPair> candidates;
+  BroadPhaseScratch bpScratch;
+  QueryScratch scratch;
+  QueryResult result;
+  std::vector<std::pair<PairState*, std::array<BodyId, 2>>> order;
+  std::map<std::uint64_t, PairReport> pairReports;
+
+  void validateSettings() const {
+    const WorldSettings& s = settings;
+    auto bad = [](const std::string& m) { throw Error(ErrorCode::kInvalidArgument, "world settings: " + m); };
+    if (!finite(s.gravity)) bad("gravity must be finite");
+    if (s.maxContacts == 0) bad("maxContacts must be >= 1");
+    if (s.velocityIterations == 0) bad("velocityIterations must be >= 1");
+    if (!(s.correctionFactor > 0.0 && s.correctionFactor <= 1.0)) bad("correctionFactor must be in (0, 1]");
+    if (!(s.slopRel >= 0.0 && std::isfinite(s.slopRel))) bad("slopRel must be >= 0 and finite");
+    if (!(s.restitutionThreshold >= 0.0 && std::isfinite(s.restitutionThreshold))) bad("restitutionThreshold must be >= 0");
+    if (!(s.convergenceRel >= 0.0)) bad("convergenceRel must be >= 0");
+    if (s.maxSubsteps == 0) bad("maxSubsteps must be >= 1");
+  }
+
+  void substep(double h, std::uint64_t budget);
+  void solve(double h);
+  void integrate(double h);
+  void checkFinite() const;
+};
+
+World::World(const WorldSettings& settings) : impl_(std::make_unique<Impl>()) {
+  impl_->settings = settings;
+  impl_->validateSettings();
+}
+World::~World() = default;
+World::World(World&&) noexcept = default;
+World& World::operator=(World&&) noexcept = default;
+
+BodyId World::addBody(const RigidBodyDesc& d) {
+  const std::string who = "body " + std::to_string(impl_->bodies.size()) + " '" + d.name + "': ";
+  auto bad = [&](const std::string& m) { throw Error(ErrorCode::kInvalidArgument, who + m); };
+  if (!d.shape) bad("no collision shape");
+  if (!(d.restitution >= 0.0 && d.restitution <= 1.0)) bad("restitution must be in [0, 1]");
+  if (!(d.friction >= 0.0 && std::isfinite(d.friction))) bad("friction must be >= 0 and finite");
+  if (!finite(d.position) || !finite(d.velocity) || !finite(d.angularVelocity) || !d.orientation.coeffs().allFinite() ||
+      !finite(d.centerOfMass))
+    bad("state must be finite");
+  if (d.orientation.norm() < 1e-12) bad("orientation quaternion is zero");
+  Body b;
+  b.desc = d;
+  b.type = d.type;
+  b.comLocal = d.centerOfMass;
+  b.q = d.orientation.normalized();
+  b.desc.orientation = b.q;
+  b.x = d.position + b.q * b.comLocal;
+  b.localBox = d.shape->mesh().bounds();
+  b.minExtent = b.localBox.extent().minCoeff();
+  if (d.type == BodyType::kDynamic) {
+    if (!(d.mass > 0.0 && std::isfinite(d.mass))) bad("mass must be > 0 and finite");
+    if (!d.inertia.allFinite()) bad("inertia must be finite");
+    Eigen::SelfAdjointEigenSolver<Mat3> eig(0.5 * (d.inertia + d.inertia.transpose()));
+    if (eig.eigenvalues().minCoeff() <= 0.0) bad("inertia must be positive definite");
+    b.invMass = 1.0 / d.mass;
+    b.inertiaLocal = d.inertia;
+    b.invInertiaLocal = d.inertia.inverse();
+  }
+  if (d.type != BodyType::kStatic) {
+    b.v = d.velocity;
+    b.w = d.angularVelocity;
+  }
+  b.invInertiaWorld = worldInverseInertia(b.invInertiaLocal, b.q);
+  impl_->bodies.push_back(std::move(b));
+  return BodyId(impl_->bodies.size() - 1);
+}
+
+void World::Impl::checkFinite() const {
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const Body& b = bodies[i];
+    if (!finite(b.x) || !finite(b.v) || !finite(b.w) || !b.q.coeffs().allFinite())
+      throw Error(ErrorCode::kSimulationDiverged,
+                  "body " + std::to_string(i) + " '" + b.desc.name + "': state became NaN or infinite");
+  }
+}
+
+void World::Impl::substep(double h, std::uint64_t budget) {
+  const WorldSettings& s = settings;
+  // Gravity first (semi-implicit Euler: the solver then sees the velocity contacts must stop).
+  for (Body& b : bodies)
+    if (b.type == BodyType::kDynamic) b.v += s.gravity * h;
+
+  // Broad phase: boxes grown by the distance a body moves this substep (speculative margin).
+  boxes.resize(bodies.size());
+  active.resize(bodies.size());
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const Body& b = bodies[i];
+    const double reach = b.w.norm() * 0.5 * b.localBox.diagonal();
+    boxes[i] = b.worldBox((b.v.norm() + reach) * h);
+    active[i] = b.type == BodyType::kDynamic;
+  }
+  findOverlappingPairs(boxes, active.data(), candidates, bpScratch);
+  report.candidatePairs += candidates.size();
+
+  for (auto& [key, p] : pairs) p.seen = false;
+  order.clear();
+  for (const BodyPair& c : candidates) {
+    PairState& p = pairs[pairKey(c[0], c[1])];
+    p.seen = true;
+    order.push_back({&p, {c[0], c[1]}});
+  }
+  // Pairs that left the broad phase forget their contacts and caches.
+  for (auto it = pairs.begin(); it != pairs.end();)
+    it = it->second.seen ? std::next(it) : pairs.erase(it);
+
+  // Budget division: round robin over staleness, then priority; stable on the pair order.
+  std::stable_sort(order.begin(), order.end(), [](const auto& l, const auto& r) {
+    if (l.first->stale != r.first->stale) return l.first->stale > r.first->stale;
+    return l.first->priority > r.first->priority;
+  });
+  std::uint64_t remaining = budget;
+  std::size_t left = order.size();
+  QuerySettings qs;
+  qs.model = s.model;
+  qs.maxContacts = s.maxContacts;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (auto& [p, ids] : order) {
+    Body& a = bodies[ids[0]];
+    Body& bb = bodies[ids[1]];
+    PairReport& pr = pairReports[pairKey(ids[0], ids[1])];
+    pr.a = ids[0];
+    pr.b = ids[1];
+    if (budget != 0) {
+      if (remaining == 0) {
+        pr.skipped = true;
+        ++report.pairsSkipped;
+        ++p->stale;
+        --left;
+        continue;
+      }
+      qs.budget = QueryBudget::tests(std::max<std::uint64_t>(1, remaining / left));
+    } else {
+      qs.budget = QueryBudget::unlimited();
+    }
+    --left;
+    queryContacts(*a.desc.shape, a.pose(), *bb.desc.shape, bb.pose(), qs, scratch, result, &p->cache);
+    remaining -= std::min(remaining, result.tests);
+    report.testsSpent += result.tests;
+    pr.tests += result.tests;
+    pr.level = result.maxLevel;
+    pr.finished = result.finished;
+    pr.skipped = false;
+    if (!result.finished) ++report.pairsInterrupted;
+    p->stale = 0;
+    p->previous.swap(p->contacts);
+    p->contacts.clear();
+    for (const Contact& c : result.contacts) {
+      SolverContact cp;
+      cp.c = c;
+      p->contacts.push_back(cp);
+    }
+  }
+  report.narrowPhaseSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  // Prepare constraints (points are world-frame; skipped pairs keep their last ones).
+  for (auto& [p, ids] : order) {
+    Body& a = bodies[ids[0]];
+    Body& b = bodies[ids[1]];
+    const double restitution = std::max(a.desc.restitution, b.desc.restitution);
+    const double mu = std::sqrt(a.desc.friction * b.desc.friction);
+    (void)mu;
+    const double diag = std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal());
+    const double matchDistance = 0.05 * diag;
+    double maxDepth = 0.0;
+    double approach = 0.0;
+    for (SolverContact& cp : p->contacts) {
+      const Vec3& n = cp.c.normal;
+      cp.rA = cp.c.point - a.x;
+      cp.rB = cp.c.point - b.x;
+      tangents(n, cp.t1, cp.t2);
+      auto effMass = [&](const Vec3& dir) {
+        const Vec3 ra = cp.rA.cross(dir), rb = cp.rB.cross(dir);
+        const double k = a.invMass + b.invMass + ra.dot(a.invInertiaWorld * ra) + rb.dot(b.invInertiaWorld * rb);
+        return k > 0.0 ? 1.0 / k : 0.0;
+      };
+      cp.massN = effMass(n);
+      cp.massT1 = effMass(cp.t1);
+      cp.massT2 = effMass(cp.t2);
+      const Vec3 vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
+      const double vn = vr.dot(n);
+      cp.targetN = vn < -s.restitutionThreshold ? -restitution * vn : 0.0;
+      // Only the part of the depth that is certain is corrected: a sphere-model contact may be
+      // off by its errorBound (the surfaces lie somewhere inside both spheres), so correcting it
+      // would push bodies apart that do not touch (docs/dynamics.md).
+      const double certain = cp.c.depth - cp.c.errorBound - s.slopRel * diag;
+      cp.targetPos = certain > 0.0 ? s.correctionFactor * certain / h : 0.0;
+      maxDepth = std::max(maxDepth, cp.c.depth);
+      approach = std::max(approach, -vn);
+      // Warm start from the nearest previous contact of this pair.
+      if (cp.lambdaN == 0.0) {
+        double best = matchDistance;
+        const SolverContact* match = nullptr;
+        for (const SolverContact& old : p->previous) {
+          const double d = (old.c.point - cp.c.point).norm();
+          if (d < best) {
+            best = d;
+            match = &old;
+          }
+        }
+        if (match) {
+          cp.lambdaN = match->lambdaN;
+          cp.lambdaT1 = match->frictionImpulse.dot(cp.t1);
+          cp.lambdaT2 = match->frictionImpulse.dot(cp.t2);
+        }
+      }
+      cp.lambdaP = 0.0;
+      const Vec3 impulse = cp.lambdaN * n + cp.lambdaT1 * cp.t1 + cp.lambdaT2 * cp.t2;
+      a.v += a.invMass * impulse;
+      a.w += a.invInertiaWorld * cp.rA.cross(impulse);
+      b.v -= b.invMass * impulse;
+      b.w -= b.invInertiaWorld * cp.rB.cross(impulse);
+    }
+    p->priority = approach + maxDepth / h;
+  }
+  solve(h);
+  integrate(h);
+}
+
+void World::Impl::solve(double h) {
+  (void)h;
+  const auto t0 = std::chrono::steady_clock::now();
+  const WorldSettings& s = settings;
+  auto apply = [](Body& a, Body& b, const SolverContact& cp, const Vec3& impulse) {
+    a.v += a.invMass * impulse;
+    a.w += a.invInertiaWorld * cp.rA.cross(impulse);
+    b.v -= b.invMass * impulse;
+    b.w -= b.invInertiaWorld * cp.rB.cross(impulse);
+  };
+  std::uint32_t used = 0;
+  for (std::uint32_t it = 0; it < s.velocityIterations; ++it) {
+    ++used;
+    double maxChange = 0.0, maxLambda = 0.0;
+    for (auto& [p, ids] : order) {
+      Body& a = bodies[ids[0]];
+      Body& b = bodies[ids[1]];
+      const double mu = std::sqrt(a.desc.friction * b.desc.friction);
+      for (SolverContact& cp : p->contacts) {
+        // Friction first, limited by the current normal impulse (Catto 2005).
+        Vec3 vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
+        const double limit = mu * cp.lambdaN;
+        double old = cp.lambdaT1;
+        cp.lambdaT1 = std::clamp(old - cp.massT1 * vr.dot(cp.t1), -limit, limit);
+        apply(a, b, cp, (cp.lambdaT1 - old) * cp.t1);
+        maxChange = std::max(maxChange, std::abs(cp.lambdaT1 - old));
+        vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
+        old = cp.lambdaT2;
+        cp.lambdaT2 = std::clamp(old - cp.massT2 * vr.dot(cp.t2), -limit, limit);
+        apply(a, b, cp, (cp.lambdaT2 - old) * cp.t2);
+        maxChange = std::max(maxChange, std::abs(cp.lambdaT2 - old));
+        // Normal: accumulated impulse clamped to >= 0.
+        vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
+        old = cp.lambdaN;
+        cp.lambdaN = std::max(0.0, old + cp.massN * (cp.targetN - vr.dot(cp.c.normal)));
+        apply(a, b, cp, (cp.lambdaN - old) * cp.c.normal);
+        maxChange = std::max(maxChange, std::abs(cp.lambdaN - old));
+        maxLambda = std::max(maxLambda, cp.lambdaN);
+      }
+    }
+    if (s.convergenceRel > 0.0 && maxChange <= s.convergenceRel * maxLambda) break;
+  }
+  report.solverIterations += used;
+  for (auto& [p, ids] : order)
+    for (SolverContact& cp : p->contacts) cp.frictionImpulse = cp.lambdaT1 * cp.t1 + cp.lambdaT2 * cp.t2;
+
+  // Split impulses: pseudo velocities that only move positions (never enter v, w).
+  for (Body& b : bodies) {
+    b.vp.setZero();
+    b.wp.setZero();
+  }
+  for (std::uint32_t it = 0; it < s.positionIterations; ++it) {
+    for (auto& [p, ids] : order) {
+      Body& a = bodies[ids[0]];
+      Body& b = bodies[ids[1]];
+      for (SolverContact& cp : p->contacts) {
+        if (cp.targetPos <= 0.0 && cp.lambdaP == 0.0) continue;
+        const double vn = (a.vp + a.wp.cross(cp.rA) - b.vp - b.wp.cross(cp.rB)).dot(cp.c.normal);
+        const double old = cp.lambdaP;
+        cp.lambdaP = std::max(0.0, old + cp.massN * (cp.targetPos - vn));
+        const Vec3 impulse = (cp.lambdaP - old) * cp.c.normal;
+        a.vp += a.invMass * impulse;
+        a.wp += a.invInertiaWorld * cp.rA.cross(impulse);
+        b.vp -= b.invMass * impulse;
+        b.wp -= b.invInertiaWorld * cp.rB.cross(impulse);
+      }
+    }
+  }
+  report.solverSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void World::Impl::integrate(double h) {
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    Body& b = bodies[i];
+    if (b.type == BodyType::kStatic) continue;
+    b.x += (b.v + b.vp) * h;
+    const Vec3 w = b.w + b.wp;
+    const Vec3 lWorld = b.type == BodyType::kDynamic ? Vec3(b.q * (b.inertiaLocal * (b.q.conjugate() * b.w))) : Vec3::Zero();
+    const Quat dq(0.0, w.x() * 0.5 * h, w.y() * 0.5 * h, w.z() * 0.5 * h);
+    Quat q = b.q;
+    q.coeffs() += (dq * b.q).coeffs();
+    b.q = q.normalized();
+    // Keep the angular momentum of a freely rotating body exactly: the world inertia turned
+    // with the body, so w = I_world^-1 L (a constant w would change L for non-spherical inertia).
+    if (b.type == BodyType::kDynamic) {
+      b.invInertiaWorld = worldInverseInertia(b.invInertiaLocal, b.q);
+      b.w = b.invInertiaWorld * lWorld;
+    }
+    b.vp.setZero();
+    b.wp.setZero();
+    if (b.type == BodyType::kDynamic && finite(b.x) && ((b.x.array() < settings.bounds.min.array()).any() ||
+                                                        (b.x.array() > settings.bounds.max.array()).any())) {
+      report.leftBounds.push_back(BodyId(i));
+      b.type = BodyType::kStatic;
+      b.invMass = 0.0;
+      b.invInertiaLocal.setZero();
+      b.invInertiaWorld.setZero();
+      b.v.setZero();
+      b.w.setZero();
+    }
+  }
+}
+
+const StepReport& World::step(double dt) {
+  if (!(dt > 0.0 && std::isfinite(dt)))
+    throw Error(ErrorCode::kInvalidArgument, "step: dt must be > 0 and finite, got " + std::to_string(dt));
+  Impl& m = *impl_;
+  m.report = StepReport{};
+  m.pairReports.clear();
+  double maxTravel = 0.0, minExtent = std::numeric_limits<double>::infinity();
+  for (const Body& b : m.bodies) {
+    minExtent = std::min(minExtent, std::max(b.minExtent, 1e-9));
+    if (b.type == BodyType::kStatic) continue;
+    const double speed = (b.v + m.settings.gravity * dt).norm() + b.w.norm() * 0.5 * b.localBox.diagonal();
+    maxTravel = std::max(maxTravel, speed * dt);
+  }
+  std::uint32_t n = 1;
+  if (std::isfinite(minExtent) && maxTravel > 0.0) {
+    const double want = std::ceil(maxTravel / (kTravelFraction * minExtent));
+    n = std::isfinite(want) ? std::uint32_t(std::clamp(want, 1.0, double(m.settings.maxSubsteps))) : m.settings.maxSubsteps;
+  }
+  m.report.substeps = n;
+  m.report.testsBudget = m.settings.budgetTests * n;
+  const double h = dt / n;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    m.substep(h, m.settings.budgetTests);
+    m.checkFinite();
+  }
+  for (auto& [key, pr] : m.pairReports) {
+    auto it = m.pairs.find(key);
+    pr.contacts = it == m.pairs.end() ? 0 : std::uint32_t(it->second.contacts.size());
+    m.report.pairs.push_back(pr);
+  }
+  for (auto& [p, ids] : m.order)
+    for (const SolverContact& cp : p->contacts) {
+      m.report.contacts.push_back(cp.c);
+      m.report.contactBodies.push_back(ids);
+    }
+  return m.report;
+}
+
+std::size_t World::bodyCount() const noexcept { return impl_->bodies.size(); }
+
+RigidBodyState World::state(BodyId id) const {
+  CLOD_ASSERT(id < impl_->bodies.size());
+  const Body& b = impl_->bodies[id];
+  return RigidBodyState{b.x - b.q * b.comLocal, b.q, b.v, b.w};
+}
+const RigidBodyDesc& World::desc(BodyId id) const { return impl_->bodies[id].desc; }
+BodyType World::type(BodyId id) const { return impl_->bodies[id].type; }
+double World::mass(BodyId id) const {
+  const Body& b = impl_->bodies[id];
+  return b.type == BodyType::kDynamic ? b.desc.mass : 0.0;
+}
+
+Vec3 World::linearMomentum() const {
+  Vec3 p = Vec3::Zero();
+  for (const Body& b : impl_->bodies)
+    if (b.type == BodyType::kDynamic) p += b.desc.mass * b.v;
+  return p;
+}
+Vec3 World::angularMomentum() const {
+  Vec3 l = Vec3::Zero();
+  for (const Body& b : impl_->bodies)
+    if (b.type == BodyType::kDynamic)
+      l += b.desc.mass * b.x.cross(b.v) + b.q * (b.inertiaLocal * (b.q.conjugate() * b.w));
+  return l;
+}
+double World::kineticEnergy() const {
+  double e = 0.0;
+  for (const Body& b : impl_->bodies)
+    if (b.type == BodyType::kDynamic) {
+      const Vec3 wl = b.q.conjugate() * b.w;
+      e += 0.5 * b.desc.mass * b.v.squaredNorm() + 0.5 * wl.dot(b.inertiaLocal * wl);
+    }
+  return e;
+}
+double World::potentialEnergy() const {
+  double e = 0.0;
+  for (const Body& b : impl_->bodies)
+    if (b.type == BodyType::kDynamic) e -= b.desc.mass * impl_->settings.gravity.dot(b.x);
+  return e;
+}
+const WorldSettings& World::settings() const noexcept { return impl_->settings; }
+void World::setBudgetTests(std::uint64_t tests) { impl_->settings.budgetTests = tests; }
+void World::setModel(ContactModel model) {
+  if (model != impl_->settings.model) impl_->pairs.clear();
+  impl_->settings.model = model;
+}
+
+std::uint64_t World::stateHash() const {
+  // FNV-1a over the raw bits of every state component.
+  std::uint64_t hash = 1469598103934665603ull;
+  auto mix = [&](double d) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &d, sizeof bits);
+    for (int i = 0; i < 8; ++i) {
+      hash ^= (bits >> (8 * i)) & 0xffu;
+      hash *= 1099511628211ull;
+    }
+  };
+  for (const Body& b : impl_->bodies) {
+    for (int k = 0; k < 3; ++k) {
+      mix(b.x[k]);
+      mix(b.v[k]);
+      mix(b.w[k]);
+    }
+    for (int k = 0; k < 4; ++k) mix(b.q.coeffs()[k]);
+  }
+  return hash;
+}
+
+}  // namespace clod

@@ -1,0 +1,288 @@
+// Physics tests of the world against analytic facts: conservation laws, rest, stacking,
+// tunnelling. Every tolerance is justified where it is used.
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+
+#include <gtest/gtest.h>
+
+#include "clod/bake.h"
+#include "clod/collision_body.h"
+#include "clod/contact_tree_builder.h"
+#include "clod/error.h"
+#include "clod/mass_properties.h"
+#include "clod/primitives.h"
+#include "clod/proximity.h"
+#include "clod/world.h"
+
+namespace clod {
+namespace {
+
+bool sanitizerRun() {
+  const char* s = std::getenv("CLOD_TEST_SCALE");
+  return s && std::strcmp(s, "sanitizer") == 0;
+}
+
+std::shared_ptr<const CollisionBody> bakeShape(const TriangleMesh& mesh) {
+  BakeSettings settings;
+  settings.sphereTree.method = SphereTreeMethod::kOctree;
+  settings.sphereTree.depth = 3;
+  settings.measureFit = false;
+  BakeResult baked = bakeMesh(mesh, settings);
+  auto body = std::make_shared<CollisionBody>(CollisionBody::fromBake(baked.contents));
+  ContactTreeSettings ct;
+  ct.maxDepth = 6;
+  body->setContactTree(buildContactTree(MeshDistance(mesh), ct));
+  return body;
+}
+
+const std::shared_ptr<const CollisionBody>& unitCube() {
+  static const auto shape = bakeShape(makeBox(Vec3(0.5, 0.5, 0.5)));
+  return shape;
+}
+
+RigidBodyDesc dynamicBox(const std::shared_ptr<const CollisionBody>& shape, const Vec3& halfExtents, double mass) {
+  RigidBodyDesc d;
+  d.shape = shape;
+  d.mass = mass;
+  // Solid box about its centre: I = m/3 diag(hy^2+hz^2, ...) (half extents).
+  d.inertia = Mat3::Zero();
+  d.inertia(0, 0) = mass / 3.0 * (halfExtents.y() * halfExtents.y() + halfExtents.z() * halfExtents.z());
+  d.inertia(1, 1) = mass / 3.0 * (halfExtents.x() * halfExtents.x() + halfExtents.z() * halfExtents.z());
+  d.inertia(2, 2) = mass / 3.0 * (halfExtents.x() * halfExtents.x() + halfExtents.y() * halfExtents.y());
+  return d;
+}
+
+double tiltDegrees(const Quat& q) {
+  const Vec3 up = q * Vec3::UnitZ();
+  return std::acos(std::clamp(up.z(), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+struct Collision {
+  double energyBefore, energyAfter;
+  Vec3 pBefore, pAfter, lBefore, lAfter;
+};
+
+Collision collideCubes(double restitution, ContactModel model) {
+  WorldSettings ws;
+  ws.gravity = Vec3::Zero();
+  ws.model = model;
+  World world(ws);
+  RigidBodyDesc moving = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 2.0);
+  moving.name = "moving";
+  moving.friction = 0.0;
+  moving.restitution = restitution;
+  moving.position = Vec3(-1.5, 0.3, 0.2);  // off-centre: the hit also spins both cubes
+  moving.velocity = Vec3(3.0, 0.0, 0.0);
+  moving.angularVelocity = Vec3(0.0, 0.0, 0.5);
+  RigidBodyDesc resting = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
+  resting.name = "resting";
+  resting.friction = 0.0;
+  resting.restitution = restitution;
+  world.addBody(moving);
+  world.addBody(resting);
+  Collision c{world.kineticEnergy(), 0, world.linearMomentum(), {}, world.angularMomentum(), {}};
+  std::uint64_t contactsSeen = 0;
+  for (int i = 0; i < 60; ++i) contactsSeen += world.step(1.0 / 60.0).contacts.size();
+  EXPECT_GT(contactsSeen, 0u) << "the cubes never touched: the test would prove nothing";
+  c.energyAfter = world.kineticEnergy();
+  c.pAfter = world.linearMomentum();
+  c.lAfter = world.angularMomentum();
+  return c;
+}
+
+TEST(World, FrictionlessZeroGravityCollisionConservesMomentumAndDoesNotGainEnergy) {
+  for (ContactModel model : {ContactModel::kCfm, ContactModel::kDos}) {
+    const Collision c = collideCubes(1.0, model);
+    // Impulses act in equal and opposite pairs at one point and free flight keeps L exactly,
+    // so only rounding changes momentum: 1e-9 relative is ~1e7 ulps of headroom.
+    EXPECT_LE((c.pAfter - c.pBefore).norm(), 1e-9 * c.pBefore.norm()) << contactModelName(model);
+    EXPECT_LE((c.lAfter - c.lBefore).norm(), 1e-9 * c.lBefore.norm()) << contactModelName(model);
+    // Restitution 1: not gained (1e-9 relative allows rounding only).
+    EXPECT_LE(c.energyAfter, c.energyBefore * (1.0 + 1e-9)) << contactModelName(model);
+    // And the collision really happened: the moving cube passed momentum on.
+  }
+}
+
+TEST(World, RestitutionBelowOneLosesKineticEnergy) {
+  const Collision c = collideCubes(0.5, ContactModel::kCfm);
+  EXPECT_LT(c.energyAfter, 0.95 * c.energyBefore);  // e = 0.5 removes far more than 5 %
+  EXPECT_LE((c.pAfter - c.pBefore).norm(), 1e-9 * c.pBefore.norm());
+}
+
+TEST(World, BoxDroppedFlatComesToRestFlatWithEveryModelAndBudget) {
+  const auto slab = bakeShape(makeBox(Vec3(2.0, 2.0, 0.25)));
+  for (ContactModel model : {ContactModel::kCfm, ContactModel::kContactTree, ContactModel::kExact}) {
+    for (std::uint64_t budget : {std::uint64_t(16), std::uint64_t(64), std::uint64_t(256), std::uint64_t(0)}) {
+      WorldSettings ws;
+      ws.model = model;
+      ws.budgetTests = budget;
+      World world(ws);
+      RigidBodyDesc ground;
+      ground.name = "ground";
+      ground.shape = slab;
+      ground.type = BodyType::kStatic;
+      world.addBody(ground);
+      RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
+      box.name = "box";
+      box.position = Vec3(0.1, -0.05, 1.5);
+      world.addBody(box);
+      for (int i = 0; i < 120; ++i) world.step(1.0 / 60.0);  // 2 s
+      const RigidBodyState s = world.state(1);
+      const std::string what = std::string(contactModelName(model)) + " budget " + std::to_string(budget);
+      // At rest: slower than 1 cm/s and 0.05 rad/s (a falling box reaches 5 m/s; the solver's
+      // residual after convergence is orders of magnitude below these).
+      EXPECT_LT(s.velocity.norm(), 0.01) << what;
+      EXPECT_LT(s.angularVelocity.norm(), 0.05) << what;
+      EXPECT_LT(tiltDegrees(s.orientation), 1.0) << what;
+      // On the slab (top at z = 0.25), not through it and not hovering on a root sphere:
+      // sphere models may rest on their spheres, so up to one cube size above.
+      EXPECT_GT(s.position.z(), 0.25 + 0.5 - 0.05) << what;
+      EXPECT_LT(s.position.z(), 0.25 + 0.5 + 1.0) << what;
+    }
+  }
+}
+
+TEST(World, StackOfTenBoxesStandsForTenSeconds) {
+  const auto slab = bakeShape(makeBox(Vec3(3.0, 3.0, 0.25)));
+  WorldSettings ws;
+  ws.model = ContactModel::kCfm;
+  World world(ws);
+  RigidBodyDesc ground;
+  ground.shape = slab;
+  ground.name = "ground";
+  ground.type = BodyType::kStatic;
+  world.addBody(ground);
+  for (int i = 0; i < 10; ++i) {
+    RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
+    box.name = "box" + std::to_string(i);
+    box.position = Vec3(0.0, 0.0, 0.25 + 0.5 + 1.0 * i);
+    box.friction = 0.6;
+    world.addBody(box);
+  }
+  // Let the stack settle for 1 s, then measure the top box over 10 simulated seconds.
+  const int settle = 60, steps = sanitizerRun() ? 120 : 600;
+  for (int i = 0; i < settle; ++i) world.step(1.0 / 60.0);
+  const Vec3 top0 = world.state(10).position;
+  double maxMove = 0.0;
+  for (int i = 0; i < steps; ++i) {
+    world.step(1.0 / 60.0);
+    maxMove = std::max(maxMove, (world.state(10).position - top0).norm());
+  }
+  EXPECT_LT(maxMove, 0.01 * 1.0);  // 1 % of the box size (1 m)
+  EXPECT_LT(tiltDegrees(world.state(10).orientation), 1.0);
+}
+
+TEST(World, FastBallDoesNotTunnelThroughThinBox) {
+  const auto ball = bakeShape(makeIcosphere(0.1, 2));
+  const auto wall = bakeShape(makeBox(Vec3(0.02, 1.0, 1.0)));  // 4 cm thick
+  WorldSettings ws;
+  ws.gravity = Vec3::Zero();
+  World world(ws);
+  RigidBodyDesc w;
+  w.shape = wall;
+  w.name = "wall";
+  w.type = BodyType::kStatic;
+  world.addBody(w);
+  RigidBodyDesc b;
+  b.shape = ball;
+  b.name = "ball";
+  b.mass = 1.0;
+  b.inertia = Mat3::Identity() * (0.4 * 0.1 * 0.1);  // solid sphere 2/5 m r^2
+  b.position = Vec3(-1.0, 0.0, 0.0);
+  b.velocity = Vec3(50.0, 0.0, 0.0);  // 0.83 m per 1/60 s frame: 20x the wall's thickness
+  world.addBody(b);
+  for (int i = 0; i < 30; ++i) world.step(1.0 / 60.0);
+  EXPECT_LT(world.state(1).position.x(), 0.0);   // still on the near side
+  EXPECT_LT(world.state(1).velocity.x(), 0.0);   // and bounced back
+}
+
+TEST(World, NonFiniteStateStopsTheStepNamingTheBody) {
+  World world(WorldSettings{});
+  RigidBodyDesc b = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
+  b.name = "rocket";
+  b.velocity = Vec3(1e308, 1e308, 0.0);
+  world.addBody(b);
+  try {
+    for (int i = 0; i < 5; ++i) world.step(1.0 / 60.0);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kSimulationDiverged);
+    EXPECT_NE(std::string(e.what()).find("rocket"), std::string::npos) << e.what();
+  }
+}
+
+TEST(World, BodyLeavingTheBoundsIsReportedAndFrozen) {
+  WorldSettings ws;
+  ws.bounds = Aabb{Vec3::Constant(-10.0), Vec3::Constant(10.0)};
+  World world(ws);
+  RigidBodyDesc b = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
+  b.name = "faller";
+  world.addBody(b);
+  bool reported = false;
+  for (int i = 0; i < 120 && !reported; ++i) reported = !world.step(1.0 / 60.0).leftBounds.empty();
+  // Free fall from z = 0 reaches z = -10 after sqrt(2 * 10 / 9.81) = 1.43 s < 2 s.
+  EXPECT_TRUE(reported);
+  EXPECT_EQ(world.type(0), BodyType::kStatic);
+}
+
+TEST(World, BadBodyAndStepArgumentsThrowInvalidArgument) {
+  World world(WorldSettings{});
+  RigidBodyDesc b = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
+  b.mass = -1.0;
+  EXPECT_THROW(world.addBody(b), Error);
+  b.mass = 1.0;
+  b.restitution = 2.0;
+  EXPECT_THROW(world.addBody(b), Error);
+  EXPECT_THROW(world.step(0.0), Error);
+}
+
+TEST(World, BudgetBoundsTheTestsOfEveryFrame) {
+  const auto slab = bakeShape(makeBox(Vec3(3.0, 3.0, 0.25)));
+  WorldSettings ws;
+  ws.budgetTests = 40;
+  World world(ws);
+  RigidBodyDesc ground;
+  ground.shape = slab;
+  ground.type = BodyType::kStatic;
+  world.addBody(ground);
+  for (int i = 0; i < 8; ++i) {
+    RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
+    box.position = Vec3(-2.0 + 0.55 * i, 0.0, 0.8 + 0.3 * i);
+    world.addBody(box);
+  }
+  std::uint64_t interrupted = 0;
+  for (int i = 0; i < 90; ++i) {
+    const StepReport& r = world.step(1.0 / 60.0);
+    // A substep makes at most max(budget, pairs) tests (a pair's share is at least 1 test).
+    EXPECT_LE(r.testsSpent, std::max<std::uint64_t>(r.testsBudget, r.candidatePairs)) << "step " << i;
+    interrupted += r.pairsInterrupted + r.pairsSkipped;
+  }
+  EXPECT_GT(interrupted, 0u) << "the budget never bit: the test would prove nothing";
+}
+
+TEST(World, SameSceneGivesBitIdenticalStates) {
+  auto run = [] {
+    const auto slab = bakeShape(makeBox(Vec3(3.0, 3.0, 0.25)));
+    WorldSettings ws;
+    ws.budgetTests = 64;
+    World world(ws);
+    RigidBodyDesc ground;
+    ground.shape = slab;
+    ground.type = BodyType::kStatic;
+    world.addBody(ground);
+    for (int i = 0; i < 5; ++i) {
+      RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
+      box.position = Vec3(0.3 * i, 0.1 * i, 1.0 + 1.1 * i);
+      box.orientation = Quat(Eigen::AngleAxisd(0.3 * i, Vec3(1, 1, 0).normalized()));
+      world.addBody(box);
+    }
+    for (int i = 0; i < 60; ++i) world.step(1.0 / 60.0);
+    return world.stateHash();
+  };
+  EXPECT_EQ(run(), run());
+}
+
+}  // namespace
+}  // namespace clod
