@@ -278,16 +278,25 @@ void World::Impl::substep(double h, std::uint64_t budget) {
       cp.massT2 = effMass(cp.t2);
       const Vec3 vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
       const double vn = vr.dot(n);
-      cp.targetN = vn < -s.restitutionThreshold ? -restitution * vn : 0.0;
+      // Restitution by Poisson's hypothesis, applied after the velocity iterations: the solver
+      // first stops the approach (compression impulse), then adds restitution x that impulse.
+      // For frictionless contact this never gains energy, even with many simultaneous contacts
+      // (Stronge, "Impact Mechanics", 2000), unlike per-point velocity targets.
+      cp.targetN = vn < -s.restitutionThreshold ? restitution : 0.0;
       // Only the part of the depth that is certain is corrected: a sphere-model contact may be
       // off by its errorBound (the surfaces lie somewhere inside both spheres), so correcting it
       // would push bodies apart that do not touch (docs/dynamics.md).
-      const double certain = cp.c.depth - cp.c.errorBound - s.slopRel * diag;
+      // The contact tree's depth comes from its distance field (errorBound there is the field's
+      // interpolation error, not a doubt about contact), so it is corrected as it is.
+      const double doubt = s.model == ContactModel::kContactTree ? 0.0 : cp.c.errorBound;
+      const double certain = cp.c.depth - doubt - s.slopRel * diag;
       cp.targetPos = certain > 0.0 ? s.correctionFactor * certain / h : 0.0;
       maxDepth = std::max(maxDepth, cp.c.depth);
       approach = std::max(approach, -vn);
       // Warm start from the nearest previous contact of this pair.
-      if (cp.lambdaN == 0.0) {
+      // Only resting contact is warm started: re-applying last substep's impulse to a pair that
+      // is now separating fast (after a bounce) would add energy the iterations may not remove.
+      if (cp.lambdaN == 0.0 && std::abs(vn) < s.restitutionThreshold) {
         double best = matchDistance;
         const SolverContact* match = nullptr;
         for (const SolverContact& old : p->previous) {
@@ -350,7 +359,7 @@ void World::Impl::solve(double h) {
         // Normal: accumulated impulse clamped to >= 0.
         vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
         old = cp.lambdaN;
-        cp.lambdaN = std::max(0.0, old + cp.massN * (cp.targetN - vr.dot(cp.c.normal)));
+        cp.lambdaN = std::max(0.0, old - cp.massN * vr.dot(cp.c.normal));
         apply(a, b, cp, (cp.lambdaN - old) * cp.c.normal);
         maxChange = std::max(maxChange, std::abs(cp.lambdaN - old));
         maxLambda = std::max(maxLambda, cp.lambdaN);
@@ -359,6 +368,12 @@ void World::Impl::solve(double h) {
     if (s.convergenceRel > 0.0 && maxChange <= s.convergenceRel * maxLambda) break;
   }
   report.solverIterations += used;
+  for (auto& [p, ids] : order)
+    for (SolverContact& cp : p->contacts)
+      if (cp.targetN > 0.0) {
+        apply(bodies[ids[0]], bodies[ids[1]], cp, cp.targetN * cp.lambdaN * cp.c.normal);
+        cp.targetN = 0.0;  // a contact bounces once
+      }
   for (auto& [p, ids] : order)
     for (SolverContact& cp : p->contacts) cp.frictionImpulse = cp.lambdaT1 * cp.t1 + cp.lambdaT2 * cp.t2;
 
