@@ -1,0 +1,117 @@
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "clod/error.h"
+#include "clod/scene.h"
+
+namespace clod {
+namespace {
+
+std::string sceneError(const std::string& json) {
+  try {
+    parseScene(json, ".", "t.json");
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kSceneError) << e.what();
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(SceneParse, WrongTypeNamesTheKeyPath) {
+  EXPECT_EQ(sceneError(R"({"bodies": [{"box": [1,1,1]}, {"box": [1,1,1]}, {"box": [1,1,1]},
+                                      {"box": [1,1,1], "velocity": [0, "x", 0]}]})"),
+            "t.json: bodies[3].velocity[1]: expected a number");
+}
+
+TEST(SceneParse, UnknownKeysAreErrors) {
+  EXPECT_EQ(sceneError(R"({"bodies": [], "gravty": [0,0,0]})"), "t.json: gravty: unknown key");
+  EXPECT_EQ(sceneError(R"({"bodies": [{"box": [1,1,1], "colour": 1}]})"), "t.json: bodies[0].colour: unknown key");
+  EXPECT_EQ(sceneError(R"({"bodies": [{"box": [1,1,1], "bake": {"depht": 2}}]})"),
+            "t.json: bodies[0].bake.depht: unknown key");
+}
+
+TEST(SceneParse, OutOfRangeAndConflictingValuesAreErrors) {
+  EXPECT_NE(sceneError(R"({"bodies": [{"box": [1,1,1], "restitution": 1.5}]})").find("bodies[0].restitution"),
+            std::string::npos);
+  EXPECT_NE(sceneError(R"({"bodies": [{"box": [1,1,1], "sphere": 1}]})").find("exactly one of"), std::string::npos);
+  EXPECT_NE(sceneError(R"({"bodies": [{"box": [1,1,1], "mass": 1, "density": 2}]})").find("not both"),
+            std::string::npos);
+  EXPECT_NE(sceneError(R"({"bodies": [{"box": [1,1]}]})").find("bodies[0].box: expected 3 numbers"), std::string::npos);
+  EXPECT_NE(sceneError(R"({"bodies": [], "contact_model": "magic"})").find("contact_model"), std::string::npos);
+  EXPECT_NE(sceneError(R"({"bodies": [], "dt": -1})").find("dt: expected a number > 0"), std::string::npos);
+  EXPECT_NE(sceneError(R"({"bodies": [{"box": [1,1,1], "orientation": [0,0,0,0]}]})").find("bodies[0].orientation"),
+            std::string::npos);
+  EXPECT_NE(sceneError("{not json").find("not valid JSON"), std::string::npos);
+  EXPECT_NE(sceneError(R"({"dt": 0.01})").find("bodies: missing"), std::string::npos);
+}
+
+TEST(SceneParse, ReadsEveryFieldAsWritten) {
+  const SceneDescription s = parseScene(R"({"gravity": [0, 0, -1], "dt": 0.01, "duration": 0.5,
+      "contact_model": "exact", "budget": 64, "max_contacts": 4,
+      "bodies": [{"name": "a", "box": [1, 2, 3], "static": true},
+                 {"name": "b", "sphere": 0.25, "position": [1, 2, 3], "orientation": [0, 0, 0, 2],
+                  "velocity": [4, 5, 6], "angular_velocity": [7, 8, 9], "mass": 3, "restitution": 0.5,
+                  "friction": 0.1, "bake": {"depth": 2, "method": "medial"}},
+                 {"mesh": "m/x.obj", "scale": 2}]})",
+                                        "/base", "t.json");
+  EXPECT_EQ(s.world.gravity, Vec3(0, 0, -1));
+  EXPECT_EQ(s.steps, 50u);  // 0.5 s / 0.01 s
+  EXPECT_EQ(s.world.model, ContactModel::kExact);
+  EXPECT_EQ(s.world.budgetTests, 64u);
+  EXPECT_EQ(s.world.maxContacts, 4u);
+  ASSERT_EQ(s.bodies.size(), 3u);
+  EXPECT_EQ(s.bodies[0].type, BodyType::kStatic);
+  EXPECT_EQ(s.bodies[0].halfExtents, Vec3(1, 2, 3));
+  EXPECT_EQ(s.bodies[1].shape, SceneShapeKind::kSphere);
+  EXPECT_DOUBLE_EQ(s.bodies[1].radius, 0.25);
+  EXPECT_DOUBLE_EQ(s.bodies[1].orientation.z(), 1.0);  // normalised [w,x,y,z] = [0,0,0,1]
+  EXPECT_EQ(s.bodies[1].angularVelocity, Vec3(7, 8, 9));
+  EXPECT_DOUBLE_EQ(*s.bodies[1].mass, 3.0);
+  EXPECT_EQ(s.bodies[1].bake.depth, 2u);
+  EXPECT_EQ(s.bodies[2].meshPath, std::filesystem::path("/base/m/x.obj"));
+  EXPECT_EQ(s.bodies[2].name, "body2");
+}
+
+TEST(SceneBuild, GivenMassAndAnalyticBoxInertiaReachTheWorld) {
+  const SceneDescription s = parseScene(
+      R"({"bodies": [{"box": [0.5, 1.0, 1.5], "mass": 6, "bake": {"depth": 1}}]})", ".", "t.json");
+  const World world = buildWorld(s, {});
+  EXPECT_NEAR(world.mass(0), 6.0, 1e-12);
+  // Solid box: I_xx = m/3 (hy^2 + hz^2) = 2 * (1 + 2.25) = 6.5 (half extents).
+  EXPECT_NEAR(world.desc(0).inertia(0, 0), 6.5, 1e-9);
+  EXPECT_NEAR(world.desc(0).inertia(2, 2), 2.0 * (0.25 + 1.0), 1e-9);
+}
+
+TEST(SceneBuild, SecondBuildLoadsShapesFromTheCache) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "clod_scene_cache_test";
+  std::filesystem::remove_all(dir);
+  const SceneDescription s = parseScene(
+      R"({"bodies": [{"box": [0.5, 0.5, 0.5], "bake": {"depth": 1}}, {"box": [0.5, 0.5, 0.5], "bake": {"depth": 1}},
+                     {"sphere": 0.3, "bake": {"depth": 1}}]})", ".", "t.json");
+  SceneBuildReport first, second;
+  buildWorld(s, dir, &first);
+  buildWorld(s, dir, &second);
+  EXPECT_EQ(first.shapesBaked, 2u);  // the two equal boxes share one shape
+  EXPECT_EQ(first.shapesFromCache, 0u);
+  EXPECT_EQ(second.shapesBaked, 0u);
+  EXPECT_EQ(second.shapesFromCache, 2u);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(SceneBuild, ShippedScenesParse) {
+  for (const char* name : {"box_on_box", "bunny_on_box", "cubes_zero_g", "bunnies_zero_g", "stack_10", "bin_200"}) {
+    const std::filesystem::path p = std::filesystem::path(CLOD_TEST_DATA_DIR) / ".." / ".." / "scenes" / (std::string(name) + ".json");
+    SceneDescription s;
+    EXPECT_NO_THROW(s = loadScene(p)) << name;
+    for (const SceneBody& b : s.bodies) {
+      if (b.shape == SceneShapeKind::kMesh) {
+        EXPECT_TRUE(std::filesystem::exists(b.meshPath)) << b.meshPath;
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace clod
