@@ -5,7 +5,7 @@
 // used in the step's last substep; the normal points from body_b toward body_a, contact.h) and
 // OUTDIR/summary.json ({"bodies": [{"name", "position", "orientation" [w,x,y,z], "velocity",
 // "angular_velocity"}], "energy": [per step, kinetic + potential], "budget_spent": [tests per
-// step], "tests_total", "left_bounds": [...], ...}). Baked shapes are cached in
+// step], "step_seconds": [wall time per step], "tests_total", "left_bounds": [...], ...}). Baked shapes are cached in
 // OUTDIR/bake-cache, so a second run starts at once.
 #include <chrono>
 #include <cstdint>
@@ -62,12 +62,15 @@ int runSimulate(const SimulateOptions& o) {
   traj << "step,time,body,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n";
   contacts << "step,body_a,body_b,px,py,pz,nx,ny,nz,depth,level\n";
   for (BodyId i = 0; i < world.bodyCount(); ++i) appendState(traj, 0, 0.0, names[i], world.state(i));
+  nlohmann::json stepSeconds = nlohmann::json::array();
   nlohmann::json energy = nlohmann::json::array(), spent = nlohmann::json::array(), left = nlohmann::json::array();
   std::uint64_t testsTotal = 0, skipped = 0, interrupted = 0;
   const auto start = std::chrono::steady_clock::now();
   bool barShown = false;
   for (std::uint32_t step = 1; step <= scene.steps; ++step) {
+    const auto stepStart = std::chrono::steady_clock::now();
     const StepReport& r = world.step(scene.dt);
+    stepSeconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - stepStart).count());
     const double time = step * scene.dt;
     for (BodyId i = 0; i < world.bodyCount(); ++i) appendState(traj, step, time, names[i], world.state(i));
     for (std::size_t c = 0; c < r.contacts.size(); ++c) {
@@ -112,6 +115,7 @@ int runSimulate(const SimulateOptions& o) {
                             {"budget", scene.world.budgetTests},
                             {"energy", energy},
                             {"budget_spent", spent},
+                            {"step_seconds", stepSeconds},
                             {"tests_total", testsTotal},
                             {"pair_queries_skipped", skipped},
                             {"pair_queries_interrupted", interrupted},
