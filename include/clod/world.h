@@ -53,7 +53,7 @@ struct WorldSettings {
   /// Manifold size per pair (QuerySettings::maxContacts), >= 1.
   std::uint32_t maxContacts = 8;
   /// Velocity iterations of the sequential-impulse solver (>= 1); position iterations likewise.
-  std::uint32_t velocityIterations = 12;
+  std::uint32_t velocityIterations = 20;
   std::uint32_t positionIterations = 4;
   /// Stop iterating early when no impulse changed by more than this (relative to the largest
   /// accumulated impulse); 0 = always run every iteration.
