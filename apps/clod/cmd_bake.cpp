@@ -9,6 +9,11 @@
 // each levels entry also has samples_per_sphere_max / samples_per_sphere_min (sample points of
 // that level's spheres' maps, the paper's Table 1 "samples"), stacks, stored_normals_min/max and
 // single_normal_spheres; top level: sampling, stacks, min_stacks, normal_codec, cfm_normals.
+// Contact tree (--sdf-error E relative to the bbox diagonal, default 1e-3; --sdf-depth D;
+// --no-sdf skips it): sdf_cells (octree nodes), sdf_leaves, sdf_bytes (size of the 'CTRE'
+// section in the file), sdf_seconds (build time); with --no-sdf the counts are 0 and
+// sdf_seconds is null. Extras: sdf_error, sdf_depth, sdf_depth_reached, sdf_surface_cells,
+// sdf_leaves_above_error.
 // Nothing is printed until the file is written, so an error leaves stdout empty, and a failed
 // bake leaves neither OUT.clod nor a temporary file behind.
 #include <algorithm>
@@ -43,6 +48,10 @@ struct BakeOptions {
   int stacks = ClosestFeatureMapSettings{}.rootStacks;
   int minStacks = ClosestFeatureMapSettings{}.minStacks;
   std::string normalCodec = std::string(normalCodecName(ClosestFeatureMapSettings{}.codec));
+  // Contact tree (--sdf-error, --sdf-depth, --no-sdf).
+  double sdfError = ContactTreeSettings{}.errorRel;
+  std::uint32_t sdfDepth = ContactTreeSettings{}.maxDepth;
+  bool noSdf = false;
   bool json = false;
 };
 
@@ -69,6 +78,9 @@ int runBake(const BakeOptions& options) {
   settings.closestFeatureMap.rootStacks = options.stacks;
   settings.closestFeatureMap.minStacks = std::min(options.minStacks, options.stacks);
   settings.closestFeatureMap.codec = parseNormalCodec(options.normalCodec);
+  settings.buildContactTree = !options.noSdf;
+  settings.contactTree.errorRel = options.sdfError;
+  settings.contactTree.maxDepth = options.sdfDepth;
 
   LoadedMesh loaded = loadMesh(options.meshPath);
   const BakeResult result = bakeMesh(loaded.mesh, settings);
@@ -81,6 +93,14 @@ int runBake(const BakeOptions& options) {
   const BakeContents& contents = result.contents;
   const SphereTree& tree = contents.sphereTree;
   const BakeFileReader file(bytes);
+  std::uint64_t sdfBytes = 0;
+  for (const BakeSectionEntry& e : file.entries()) {
+    if (e.tag == kBakeContactTreeTag) sdfBytes = e.size;
+  }
+  std::uint32_t sdfLeaves = 0;
+  if (contents.contactTree) {
+    for (std::uint32_t n = 0; n < contents.contactTree->nodeCount(); ++n) sdfLeaves += contents.contactTree->isLeaf(n) ? 1u : 0u;
+  }
 
   if (options.json) {
     nlohmann::json out;
@@ -131,6 +151,16 @@ int runBake(const BakeOptions& options) {
       out["normal_codec"] = normalCodecName(contents.closestFeatureMap->settings().codec);
       out["cfm_normals"] = contents.closestFeatureMap->poolSize();
     }
+    const ContactTree* sdf = contents.contactTree ? &*contents.contactTree : nullptr;
+    out["sdf_cells"] = sdf ? sdf->nodeCount() : 0u;
+    out["sdf_leaves"] = sdfLeaves;
+    out["sdf_bytes"] = sdfBytes;
+    out["sdf_seconds"] = sdf ? nlohmann::json(result.timings.contactTreeSeconds) : nlohmann::json(nullptr);
+    out["sdf_error"] = sdf ? nlohmann::json(settings.contactTree.errorRel) : nlohmann::json(nullptr);
+    out["sdf_depth"] = sdf ? nlohmann::json(settings.contactTree.maxDepth) : nlohmann::json(nullptr);
+    out["sdf_depth_reached"] = sdf ? nlohmann::json(sdf->depthCount() - 1) : nlohmann::json(nullptr);
+    out["sdf_surface_cells"] = sdf ? sdf->halfSpaces.size() : 0u;
+    out["sdf_leaves_above_error"] = result.contactTreeStats.leavesAboveError;
     out["write_seconds"] = writeSeconds;
     out["file_bytes"] = bytes.size();
     nlohmann::json sections = nlohmann::json::array();
@@ -161,6 +191,14 @@ int runBake(const BakeOptions& options) {
     }
     text << "\n";
   }
+  if (contents.contactTree) {
+    const ContactTree& sdf = *contents.contactTree;
+    text << "  contact tree: " << sdf.nodeCount() << " cells, " << sdfLeaves << " leaves, depth "
+         << sdf.depthCount() - 1 << " of " << sdf.maxDepth << ", error " << settings.contactTree.errorRel
+         << " of the bbox diagonal, " << sdfBytes << " bytes, " << result.timings.contactTreeSeconds << " s\n";
+  } else {
+    text << "  contact tree: not built (--no-sdf)\n";
+  }
   std::cout << text.str();
   return 0;
 }
@@ -168,7 +206,7 @@ int runBake(const BakeOptions& options) {
 const CommandRegistration kRegistration("bake", [](CLI::App& app) {
   auto options = std::make_shared<BakeOptions>();
   CLI::App* sub = app.add_subcommand(
-      "bake", "Build the sphere-tree (and later the other precomputed data) of a mesh and write a .clod bake file");
+      "bake", "Build the sphere-tree, closest feature maps and contact tree of a mesh and write a .clod bake file");
   sub->add_option("mesh", options->meshPath, "Mesh file (OBJ, STL, PLY, OFF, glTF/GLB)")->required();
   sub->add_option("-o,--output", options->outputPath, "Bake file to write (written atomically)")->required();
   sub->add_option("--sphere-tree", options->method, "Sphere-tree builder")
@@ -195,6 +233,14 @@ const CommandRegistration kRegistration("bake", [](CLI::App& app) {
   sub->add_option("--normal-codec", options->normalCodec, "Encoding of stored normals: oct16 or oct32")
       ->check(CLI::IsMember({"oct16", "oct32"}))
       ->capture_default_str();
+  sub->add_option("--sdf-error", options->sdfError,
+                  "Contact tree: largest interpolation error near the surface, relative to the bbox diagonal (> 0)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  sub->add_option("--sdf-depth", options->sdfDepth, "Contact tree: deepest octree level (root = 0), 1..20")
+      ->check(CLI::Range(1, 20))
+      ->capture_default_str();
+  sub->add_flag("--no-sdf", options->noSdf, "Do not build the contact tree (no 'CTRE' section)");
   sub->add_flag("--json", options->json,
                 "Print one JSON object: levels[{level, spheres, fit_mean, fit_max}] (fit in units of the "
                 "bbox diagonal), build_seconds, file_bytes, mesh_hash, vertices, triangles, sign_method, "

@@ -1,8 +1,8 @@
 #pragma once
 // Bake files (.clod): everything clod precomputes for one mesh, in one checked binary file,
-// so an engine loads assets instead of rebuilding them. Today a bake holds the mesh and its
-// sphere-tree; later versions add closest feature maps and the contact tree as further
-// sections (older readers skip sections they do not know).
+// so an engine loads assets instead of rebuilding them. A bake holds the mesh, its
+// sphere-tree, and optionally the closest feature maps and the contact tree; each is a
+// section, and readers skip sections they do not know, so later sections can be added.
 //
 // Typical use:
 //   BakeResult baked = bakeMesh(loadMesh("bunny.obj").mesh, settings);   // minutes at most
@@ -23,6 +23,8 @@
 
 #include "clod/bake_file.h"
 #include "clod/closest_feature_map.h"
+#include "clod/contact_tree.h"
+#include "clod/contact_tree_builder.h"
 #include "clod/error.h"
 #include "clod/mesh.h"
 #include "clod/proximity.h"
@@ -39,6 +41,10 @@ inline constexpr std::uint32_t kBakeSphereTreeVersion = 1;
 /// Closest feature maps of the sphere-tree (optional; layout in src/bake/cfm_section.h).
 inline constexpr BakeSectionTag kBakeCfmTag = makeBakeSectionTag("CFMP");
 inline constexpr std::uint32_t kBakeCfmVersion = 1;
+/// The contact tree of the mesh (optional; payload = encodeContactTree, contact_tree_codec.h;
+/// layout in src/bake/contact_tree_section.h and docs/bake-format.md).
+inline constexpr BakeSectionTag kBakeContactTreeTag = makeBakeSectionTag("CTRE");
+inline constexpr std::uint32_t kBakeContactTreeVersion = 1;
 
 /// 64-bit content hash of a mesh, for cache keys and to tie a bake to its mesh: XXH3-64
 /// (seed 0) over the vertex count and triangle count (u64 each), then every vertex coordinate
@@ -65,6 +71,12 @@ struct BakeContents {
   /// Closest feature maps of sphereTree (optional, 'CFMP'). Must have been built for
   /// sphereTree (encodeBake re-checks it with ClosestFeatureMap::fromData: kInvalidArgument).
   std::optional<ClosestFeatureMap> closestFeatureMap;
+
+  /// Contact tree (adaptive signed distance field) of `mesh` (optional, 'CTRE'). Must have been
+  /// built for `mesh`: its meshDiagonal equal to mesh.bounds().diagonal() bit for bit and its
+  /// root cube containing the mesh's bounding box (encodeBake checks this and every invariant
+  /// of decodeContactTree: kInvalidArgument).
+  std::optional<ContactTree> contactTree;
 };
 
 /// Encodes contents as a complete bake file. Deterministic: equal contents give identical
@@ -85,7 +97,9 @@ std::vector<std::byte> encodeBake(const BakeContents& contents);
 /// strictly increasing to the sphere count, centres finite, radii finite and >= 0, parent and
 /// child ranges pointing into the neighbouring levels and agreeing with each other,
 /// triangleOffsets monotone from 0 to the triangle list size, triangle indices < the mesh's
-/// triangle count, a known method. Other errors: kBakeTruncated, kBakeVersion (the file or a
+/// triangle count, a known method; closest feature maps consistent with the sphere-tree
+/// (ClosestFeatureMap::fromData); a contact tree passing decodeContactTree's checks, with no
+/// bytes after it, and belonging to the mesh (see BakeContents::contactTree). Other errors: kBakeTruncated, kBakeVersion (the file or a
 /// known section is newer than this build), kBakeMissingSection ('MESH' or 'STRE' absent).
 /// Sections with unknown tags are skipped. O(file size).
 BakeContents decodeBake(std::span<const std::byte> bytes);
@@ -112,6 +126,11 @@ struct BakeSettings {
   /// Build the closest feature maps (BakeContents::closestFeatureMap) with these settings.
   bool buildClosestFeatureMap = true;
   ClosestFeatureMapSettings closestFeatureMap;
+  /// Build the contact tree (BakeContents::contactTree) with these settings (errorRel is
+  /// relative to the mesh's bounding-box diagonal). Usually the slowest stage; its cost grows
+  /// roughly with the surface area over errorRel (docs/contact-tree.md).
+  bool buildContactTree = true;
+  ContactTreeSettings contactTree;
 };
 
 /// Wall-clock seconds per stage of bakeMesh.
@@ -120,7 +139,9 @@ struct BakeTimings {
   double sphereTreeSeconds = 0.0;  ///< buildSphereTree
   double fitSeconds = 0.0;         ///< measureSphereTreeFit (0 if not measured)
   double cfmSeconds = 0.0;         ///< buildClosestFeatureMap (0 if not built)
-  /// Everything that goes into the file: distanceSeconds + sphereTreeSeconds + cfmSeconds (+ later sections);
+  double contactTreeSeconds = 0.0; ///< buildContactTree (0 if not built)
+  /// Everything that goes into the file: distanceSeconds + sphereTreeSeconds + cfmSeconds +
+  /// contactTreeSeconds;
   /// excludes fit measurement.
   double buildSeconds = 0.0;
 };
@@ -133,10 +154,12 @@ struct BakeResult {
   /// How MeshDistance decided inside/outside for this mesh.
   SignMethod signMethod = SignMethod::kPseudonormal;
   BakeTimings timings;
+  /// What the contact-tree builder did (all zero unless BakeSettings::buildContactTree).
+  ContactTreeBuildStats contactTreeStats;
 };
 
-/// Builds everything a bake holds for `mesh`: MeshDistance, then the sphere-tree (and later
-/// sections). The mesh must be valid (see MeshDistance). Throws clod::Error from the
+/// Builds everything a bake holds for `mesh`: MeshDistance, then the sphere-tree, the closest
+/// feature maps and the contact tree (each of the last two unless switched off in settings). The mesh must be valid (see MeshDistance). Throws clod::Error from the
 /// builders: kInvalidArgument for out-of-range settings, mesh errors for invalid meshes.
 /// Uses TBB inside the builders.
 BakeResult bakeMesh(const TriangleMesh& mesh, const BakeSettings& settings);

@@ -14,6 +14,7 @@
 #include "clod/atomic_file.h"
 #include "clod/error.h"
 #include "cfm_section.h"
+#include "contact_tree_section.h"
 #include "mesh_section.h"
 #include "sphere_tree_section.h"
 
@@ -50,6 +51,10 @@ std::vector<std::byte> encodeBake(const BakeContents& contents) {
     }
     writer.addSection(kBakeCfmTag, kBakeCfmVersion, detail::encodeCfmSection(*contents.closestFeatureMap));
   }
+  if (contents.contactTree) {
+    detail::checkContactTree(*contents.contactTree, contents.mesh, {ErrorCode::kInvalidArgument, "encodeBake"});
+    writer.addSection(kBakeContactTreeTag, kBakeContactTreeVersion, detail::encodeContactTreeSection(*contents.contactTree));
+  }
   return writer.encode();
 }
 
@@ -70,6 +75,9 @@ BakeContents decodeBake(std::span<const std::byte> bytes) {
   }
   if (const std::optional<BakeSection> cfm = file.findSection(kBakeCfmTag, kBakeCfmVersion)) {
     contents.closestFeatureMap = detail::decodeCfmSection(cfm->payload, contents.sphereTree);
+  }
+  if (const std::optional<BakeSection> tree = file.findSection(kBakeContactTreeTag, kBakeContactTreeVersion)) {
+    contents.contactTree = detail::decodeContactTreeSection(tree->payload, contents.mesh);
   }
   return contents;
 }

@@ -25,7 +25,13 @@ BakeResult bakeMesh(const TriangleMesh& mesh, const BakeSettings& settings) {
     result.contents.closestFeatureMap = buildClosestFeatureMap(distance, result.contents.sphereTree, settings.closestFeatureMap);
     result.timings.cfmSeconds = secondsSince(start);
   }
-  result.timings.buildSeconds = result.timings.distanceSeconds + result.timings.sphereTreeSeconds + result.timings.cfmSeconds;
+  if (settings.buildContactTree) {
+    start = std::chrono::steady_clock::now();
+    result.contents.contactTree = buildContactTree(distance, settings.contactTree, &result.contactTreeStats);
+    result.timings.contactTreeSeconds = secondsSince(start);
+  }
+  result.timings.buildSeconds = result.timings.distanceSeconds + result.timings.sphereTreeSeconds +
+                                result.timings.cfmSeconds + result.timings.contactTreeSeconds;
 
   if (settings.measureFit) {
     start = std::chrono::steady_clock::now();

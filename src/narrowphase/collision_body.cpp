@@ -77,7 +77,7 @@ CollisionBody CollisionBody::fromBake(const BakeContents& bake) {
   CollisionBody body(bake.mesh, bake.sphereTree);
   body.name_ = bake.sourceName;
   if (bake.closestFeatureMap) body.setClosestFeatureMap(*bake.closestFeatureMap);
-  // The contact tree is picked up here once BakeContents carries its section.
+  if (bake.contactTree) body.setContactTree(*bake.contactTree);
   return body;
 }
 

@@ -594,7 +594,8 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
 
 // How a bake gets the section a model needs (apps/clod/cmd_bake.cpp).
 constexpr const char* kCfmOption = "'clod bake', which adds closest feature maps by default (--stacks sets their size)";
-constexpr const char* kContactTreeOption = "'clod bake --contact-tree'";
+constexpr const char* kContactTreeOption =
+    "'clod bake', which adds the contact tree unless --no-sdf is given (--sdf-error/--sdf-depth set its accuracy)";
 
 void throwMissing(const CollisionBody& body, const char* which, const char* what, const char* model,
                   const char* option) {

@@ -93,6 +93,11 @@ TEST(BakeMeshSettings, SkippingFitMeasurementLeavesItEmpty) {
 TEST(BakeCorruption, FlippedBytesAndTruncationsOfARealBakeAreRejected) {
   const BakeContents original = bakeMesh(testMesh(), smallSettings(SphereTreeMethod::kMedial)).contents;
   const std::vector<std::byte> file = encodeBake(original);
+  // The default bake carries every optional section, so the damage reaches the CFMP and CTRE
+  // payloads too.
+  ASSERT_TRUE(original.closestFeatureMap.has_value());
+  ASSERT_TRUE(original.contactTree.has_value());
+  ASSERT_EQ(BakeFileReader(file).entries().size(), 4u);
   const std::size_t tableEnd = 48 + 32 * BakeFileReader(file).entries().size();
   std::vector<std::size_t> positions;
   for (std::size_t i = 0; i < tableEnd; ++i) positions.push_back(i);

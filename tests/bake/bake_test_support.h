@@ -88,6 +88,29 @@ inline BakeContents makeTestContents() {
   return contents;
 }
 
+/// Bitwise equality of two contact trees, one assertion per field.
+inline void expectSameContactTree(const ContactTree& a, const ContactTree& b) {
+  auto sameBits = [](const auto& x, const auto& y) { return std::memcmp(&x, &y, sizeof(x)) == 0; };
+  EXPECT_TRUE(sameBits(a.origin.x(), b.origin.x()) && sameBits(a.origin.y(), b.origin.y()) &&
+              sameBits(a.origin.z(), b.origin.z()));
+  EXPECT_TRUE(sameBits(a.rootSize, b.rootSize));
+  EXPECT_TRUE(sameBits(a.meshDiagonal, b.meshDiagonal));
+  EXPECT_TRUE(sameBits(a.errorAbs, b.errorAbs));
+  EXPECT_TRUE(sameBits(a.bandAbs, b.bandAbs));
+  EXPECT_EQ(a.maxDepth, b.maxDepth);
+  EXPECT_TRUE(sameBits(a.rootCorners, b.rootCorners));
+  EXPECT_EQ(a.firstChild, b.firstChild);
+  EXPECT_EQ(a.errorBound.size(), b.errorBound.size());
+  EXPECT_TRUE(a.errorBound.size() == b.errorBound.size() &&
+              std::memcmp(a.errorBound.data(), b.errorBound.data(), a.errorBound.size() * sizeof(float)) == 0);
+  EXPECT_EQ(a.halfSpaceIndex, b.halfSpaceIndex);
+  EXPECT_EQ(a.levelOffsets, b.levelOffsets);
+  EXPECT_TRUE(a.lattice.size() == b.lattice.size() &&
+              std::memcmp(a.lattice.data(), b.lattice.data(), a.lattice.size() * sizeof(float)) == 0);
+  EXPECT_TRUE(a.halfSpaces.size() == b.halfSpaces.size() &&
+              std::memcmp(a.halfSpaces.data(), b.halfSpaces.data(), a.halfSpaces.size() * sizeof(ContactHalfSpace)) == 0);
+}
+
 /// Field-by-field equality, with one assertion per field so a failure names it.
 inline void expectSameContents(const BakeContents& a, const BakeContents& b) {
   ASSERT_EQ(a.mesh.vertices.size(), b.mesh.vertices.size());
@@ -114,6 +137,9 @@ inline void expectSameContents(const BakeContents& a, const BakeContents& b) {
   EXPECT_EQ(s.triangleOffsets, t.triangleOffsets);
   EXPECT_EQ(s.triangleList, t.triangleList);
   EXPECT_EQ(s.levelOffsets, t.levelOffsets);
+  EXPECT_EQ(a.closestFeatureMap.has_value(), b.closestFeatureMap.has_value());
+  ASSERT_EQ(a.contactTree.has_value(), b.contactTree.has_value());
+  if (a.contactTree) expectSameContactTree(*a.contactTree, *b.contactTree);
 }
 
 /// Runs `f` and returns the clod::Error code it threw; fails the test if it threw nothing.

@@ -78,7 +78,7 @@ protected:
 TEST_F(CliBake, JsonHasTheContractKeysAndSpheresMatchTheLevelCounts) {
   const fs::path mesh = sharedMesh("bunny-1500.obj");
   const fs::path out = dir_ / "bunny.clod";
-  const CliRun run = runCli("bake " + quoted(mesh) + " -o " + quoted(out) + " --sphere-tree octree --levels 3 --json");
+  const CliRun run = runCli("bake " + quoted(mesh) + " -o " + quoted(out) + " --sphere-tree octree --levels 3 --sdf-error 1e-2 --json");
   ASSERT_EQ(run.exitCode, 0) << run.err;
   const nlohmann::json j = nlohmann::json::parse(run.out);
   for (const char* key : {"levels", "build_seconds", "file_bytes", "mesh_hash", "vertices", "triangles", "sign_method",
@@ -97,6 +97,20 @@ TEST_F(CliBake, JsonHasTheContractKeysAndSpheresMatchTheLevelCounts) {
   ASSERT_EQ(j["levels"].size(), 4u) << "--levels 3 means 3 levels below the root";
   EXPECT_EQ(j["levels"][0]["spheres"], 1);
   EXPECT_EQ(filesInDir(), 1u) << "only the bake file, no temporary left behind";
+
+  // The contact tree is built by default: its keys, octree counts (1 + 8k cells, 1 + 7k leaves)
+  // and the size of its 'CTRE' section as listed in the file's own table.
+  for (const char* key : {"sdf_cells", "sdf_leaves", "sdf_bytes", "sdf_seconds"}) ASSERT_TRUE(j.contains(key)) << key;
+  const auto sdfCells = j["sdf_cells"].get<std::uint64_t>();
+  ASSERT_GT(sdfCells, 1u);
+  EXPECT_EQ((sdfCells - 1) % 8, 0u);
+  EXPECT_EQ(j["sdf_leaves"].get<std::uint64_t>(), 1 + 7 * ((sdfCells - 1) / 8));
+  EXPECT_GE(j["sdf_seconds"].get<double>(), 0.0);
+  bool ctre = false;
+  for (const auto& section : j["sections"]) {
+    if (section["tag"] == "CTRE") ctre = section["bytes"] == j["sdf_bytes"];
+  }
+  EXPECT_TRUE(ctre) << j["sections"].dump();
 
   // Sphere coverage, checked against the OBJ's own vertices: every vertex lies in a sphere of
   // every level. Tolerance: the loader may weld vertices within 1e-7 of the bbox diagonal and
@@ -134,7 +148,7 @@ TEST_F(CliBake, JsonHasTheContractKeysAndSpheresMatchTheLevelCounts) {
 TEST_F(CliBake, MedialBakeWithoutJsonPrintsASummary) {
   const fs::path out = dir_ / "suzanne.clod";
   const CliRun run = runCli("bake " + quoted(sharedMesh("suzanne.obj")) + " -o " + quoted(out) +
-                            " --sphere-tree medial --branching 4 --levels 2 --medial-samples 1000");
+                            " --sphere-tree medial --branching 4 --levels 2 --medial-samples 1000 --no-sdf");
   ASSERT_EQ(run.exitCode, 0) << run.err;
   EXPECT_NE(run.out.find("suzanne.clod"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("level 2"), std::string::npos) << run.out;
@@ -144,7 +158,7 @@ TEST_F(CliBake, MedialBakeWithoutJsonPrintsASummary) {
 TEST_F(CliBake, OutOfRangeLevelIsUsageErrorNamingTheValidRange) {
   const fs::path out = dir_ / "box.clod";
   ASSERT_EQ(runCli("bake " + quoted(sharedMesh("bunny-1500.obj")) + " -o " + quoted(out) +
-                   " --sphere-tree octree --levels 2 --json")
+                   " --sphere-tree octree --levels 2 --no-sdf --json")
                 .exitCode,
             0);
   for (const char* level : {"3", "-1", "4000000000"}) {
@@ -157,7 +171,7 @@ TEST_F(CliBake, OutOfRangeLevelIsUsageErrorNamingTheValidRange) {
 
 TEST_F(CliBake, DamagedOrMissingBakeFilesAreDataErrors) {
   const fs::path good = dir_ / "good.clod";
-  ASSERT_EQ(runCli("bake " + quoted(sharedMesh("bunny-1500.obj")) + " -o " + quoted(good) + " --sphere-tree octree --levels 2")
+  ASSERT_EQ(runCli("bake " + quoted(sharedMesh("bunny-1500.obj")) + " -o " + quoted(good) + " --sphere-tree octree --levels 2 --no-sdf")
                 .exitCode,
             0);
   std::string bytes;
@@ -187,7 +201,7 @@ TEST_F(CliBake, UnwritableOutputIsDataErrorAndLeavesNoFile) {
   std::ofstream(dir_ / "blocker") << "x";
   const fs::path out = dir_ / "blocker" / "bunny.clod";
   const CliRun run = runCli("bake " + quoted(sharedMesh("bunny-1500.obj")) + " -o " + quoted(out) +
-                            " --sphere-tree octree --levels 1 --json");
+                            " --sphere-tree octree --levels 1 --no-sdf --json");
   EXPECT_EQ(run.exitCode, 1) << run.err;
   EXPECT_NE(run.err.find("bunny.clod"), std::string::npos) << run.err;
   EXPECT_TRUE(run.out.empty());

@@ -81,10 +81,10 @@ TEST_F(CliNormals, BakeReportsSamplesPerSphereForEachSchemeAndStackCount) {
   struct Case { const char* args; unsigned rootSamples; };
   // 65 = the paper's adaptive polar root at 10 stacks; 163 = the same rule at 16 (the paper
   // prints 167); HEALPix has 12 N^2 pixels and 10 stacks maps to N = 2 (48).
-  const Case cases[] = {{"", 65}, {" --stacks 16", 163}, {" --sampling healpix --stacks 10", 48}, {" --sampling polar --stacks 6", 36}};
+  const Case cases[] = {{"", 163}, {" --stacks 10", 65}, {" --stacks 16", 163}, {" --sampling healpix --stacks 10", 48}, {" --sampling polar --stacks 6", 36}};
   for (const Case& c : cases) {
     const fs::path out = dir_ / "box.clod";
-    const CliRun run = runCli("bake " + quoted(kBox) + " -o " + quoted(out) + " --levels 2 --json" + c.args);
+    const CliRun run = runCli("bake " + quoted(kBox) + " -o " + quoted(out) + " --levels 2 --no-sdf --json" + c.args);
     ASSERT_EQ(run.exitCode, 0) << run.err;
     const nlohmann::json j = nlohmann::json::parse(run.out);
     ASSERT_EQ(j["levels"].size(), 3u);
@@ -98,14 +98,14 @@ TEST_F(CliNormals, BakeReportsSamplesPerSphereForEachSchemeAndStackCount) {
       previous = hi;
     }
   }
-  const CliRun bad = runCli("bake " + quoted(kBox) + " -o " + quoted(dir_ / "x.clod") + " --sampling spiral");
+  const CliRun bad = runCli("bake " + quoted(kBox) + " -o " + quoted(dir_ / "x.clod") + " --sampling spiral --no-sdf");
   EXPECT_EQ(bad.exitCode, 2) << bad.err;
   EXPECT_FALSE(fs::exists(dir_ / "x.clod"));
 }
 
 TEST_F(CliNormals, FaceCentreContactsGetFaceNormalsAndTheNearestContainingSphere) {
   const fs::path bake = dir_ / "box.clod";
-  const CliRun baked = runCli("bake " + quoted(kBox) + " -o " + quoted(bake) + " --levels 2 --json");
+  const CliRun baked = runCli("bake " + quoted(kBox) + " -o " + quoted(bake) + " --levels 2 --no-sdf --json");
   ASSERT_EQ(baked.exitCode, 0) << baked.err;
   const nlohmann::json bakeJson = nlohmann::json::parse(baked.out);
   const fs::path points = writePoints(
@@ -184,7 +184,7 @@ TEST_F(CliNormals, FaceCentreContactsGetFaceNormalsAndTheNearestContainingSphere
 
 TEST_F(CliNormals, BadInputGivesExitCodesAndNoOutput) {
   const fs::path bake = dir_ / "box.clod";
-  ASSERT_EQ(runCli("bake " + quoted(kBox) + " -o " + quoted(bake) + " --levels 1").exitCode, 0);
+  ASSERT_EQ(runCli("bake " + quoted(kBox) + " -o " + quoted(bake) + " --levels 1 --no-sdf").exitCode, 0);
   const fs::path points = writePoints("0.5 1 3\n");
   const std::string base = "normals " + quoted(bake) + " --points " + quoted(points);
   CliRun run = runCli(base + " --level 2 --json");

@@ -126,11 +126,14 @@ TEST_F(QueryCli, BadInputGivesClearMessagesAndExitCodes) {
   run = runCli("query \"" + (dir_ / "missing.clod").string() + "\" \"" + cube().string() + "\"");
   EXPECT_EQ(run.exitCode, 1);
   EXPECT_NE(run.err.find("missing.clod"), std::string::npos) << run.err;
-  // No contact tree in this bake (its section does not exist yet): bad data naming the option.
-  run = runCli(pair() + "--model contact-tree");
+  // No contact tree in this bake (baked with --no-sdf): bad data naming the option.
+  const fs::path plain = dir_ / "cube-no-sdf.clod";
+  ASSERT_EQ(runCli("bake \"" + (dir_ / "cube.obj").string() + "\" -o \"" + plain.string() + "\" --levels 2 --no-sdf").exitCode, 0);
+  run = runCli("query \"" + plain.string() + "\" \"" + plain.string() + "\" --model contact-tree");
   EXPECT_EQ(run.exitCode, 1);
   EXPECT_NE(run.err.find("contact tree"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("clod bake"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("--no-sdf"), std::string::npos) << run.err;
   EXPECT_TRUE(run.out.empty());
 }
 
