@@ -290,6 +290,7 @@ ExperimentResult runSizes(const ExperimentOptions& options) {
     settings.measureFit = false;
     settings.closestFeatureMap.rootStacks = row.stacks;
     settings.closestFeatureMap.minStacks = 1;
+    settings.buildContactTree = false;  // the paper's Table 1 files held the sphere-tree and maps only
     const BakeResult baked = bakeMesh(mesh, settings);
     const std::vector<std::byte> bytes = encodeBake(baked.contents);
     const BakeFileReader file(bytes);

@@ -263,6 +263,7 @@ World buildWorld(const SceneDescription& scene, const std::filesystem::path& cac
         bs.sphereTree.depth = sb.bake.depth;
         bs.sphereTree.branching = sb.bake.branching;
         bs.measureFit = false;
+        bs.buildContactTree = false;  // built below, with the scene's depth, only when a model needs it
         bs.sourceName = source;
         contents = bakeMesh(mesh, bs).contents;
         if (!cached.empty()) {

@@ -29,6 +29,7 @@ std::shared_ptr<const CollisionBody> bakeShape(const TriangleMesh& mesh) {
   settings.sphereTree.method = SphereTreeMethod::kOctree;
   settings.sphereTree.depth = 3;
   settings.measureFit = false;
+  settings.buildContactTree = false;  // set below with maxDepth 6
   BakeResult baked = bakeMesh(mesh, settings);
   auto body = std::make_shared<CollisionBody>(CollisionBody::fromBake(baked.contents));
   ContactTreeSettings ct;
