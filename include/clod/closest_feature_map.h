@@ -79,8 +79,11 @@ inline constexpr double kSingleNormalAngle = 1e-6;
 struct ClosestFeatureMapSettings {
   /// Sampling scheme of every sphere (sphere_sampling.h). The paper's is adaptive polar.
   SamplingScheme scheme = SamplingScheme::kAdaptivePolar;
-  /// Stacks at the root, in [1, maxSamplingResolution(kPolar)] (the paper: 10 or 16).
-  int rootStacks = 10;
+  /// Stacks at the root, in [1, maxSamplingResolution(kPolar)] (the paper: 10 or 16, "enough").
+  /// Default 16: at 10 stacks the root maps of sharp CAD parts (fandisk) are too coarse to beat
+  /// D&O there; at 16 CFM beats D&O and averaging at every level of every shared closed mesh
+  /// (`clod experiment normals`, docs/benchmarks/cfm.md). Pass 10 for the paper's Table 1 setup.
+  int rootStacks = 16;
   /// Lower bound of the per-level stack count, in [1, rootStacks]. 1 reproduces the paper's
   /// halving down to one sample; the default 2 keeps at least the paper's leaf resolution.
   int minStacks = 2;
