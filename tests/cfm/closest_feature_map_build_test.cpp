@@ -346,7 +346,7 @@ TEST(CfmBuildSettings, OutOfRangeSettingsAreInvalidArguments) {
   s.rootStacks = 0;
   EXPECT_EQ(code(s), ErrorCode::kInvalidArgument);
   s = {};
-  s.minStacks = 11;
+  s.minStacks = s.rootStacks + 1;
   EXPECT_EQ(code(s), ErrorCode::kInvalidArgument);
   s = {};
   s.scheme = static_cast<SamplingScheme>(42);

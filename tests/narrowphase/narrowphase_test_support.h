@@ -25,6 +25,8 @@ inline CollisionBody makeTestBody(const TriangleMesh& mesh, std::uint32_t depth,
   settings.sphereTree.depth = depth;
   settings.sphereTree.medialSamples = 2000;
   settings.measureFit = false;
+  settings.buildClosestFeatureMap = false;  // built below with finer settings
+  settings.buildContactTree = false;       // likewise
   const BakeResult baked = bakeMesh(mesh, settings);
   CollisionBody body = CollisionBody::fromBake(baked.contents);
   const MeshDistance distance(mesh);
