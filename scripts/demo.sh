@@ -19,3 +19,6 @@ echo "== clod bake"
 build/bin/clod bake "$mesh" -o "$out/bunny.clod"
 echo "== clod spheres --level 1"
 build/bin/clod spheres "$out/bunny.clod" --level 1 --json | head -20
+echo "== clod simulate scenes/bunny_on_box.json"
+build/bin/clod simulate scenes/bunny_on_box.json -o "$out/bunny_on_box" --progress
+echo "wrote $out/bunny_on_box/{trajectory.csv,contacts.csv,summary.json}"
