@@ -14,36 +14,18 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include "cli/cli_runner.h"
 #include <nlohmann/json.hpp>
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int exitCode = -1;
-  std::string out;
-  std::string err;
-};
+using clod::test::CliRun;
+using clod::test::runCli;
 
-CliRun runCli(const std::string& args) {
-  const fs::path errPath = fs::temp_directory_path() / ("clod_bake_cli_test_" + std::to_string(::getpid()) + ".err");
-  const std::string command = std::string("\"") + CLOD_CLI_PATH + "\" " + args + " 2>\"" + errPath.string() + "\"";
-  CliRun run;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return run;
-  std::array<char, 4096> buffer;
-  std::size_t n;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.out.append(buffer.data(), n);
-  const int status = ::pclose(pipe);
-  run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  std::ifstream err(errPath);
-  run.err.assign(std::istreambuf_iterator<char>(err), std::istreambuf_iterator<char>());
-  fs::remove(errPath);
-  return run;
-}
-
-std::string quoted(const fs::path& path) { return "\"" + path.string() + "\""; }
+using clod::test::quoted;
 fs::path sharedMesh(const char* name) { return fs::path(CLOD_SHARED_MESH_DIR) / name; }
 
 // The vertices of an OBJ file ('v x y z' lines), read here independently of the library.

@@ -11,34 +11,16 @@
 #include <string>
 
 #include <gtest/gtest.h>
+
+#include "cli/cli_runner.h"
 #include <nlohmann/json.hpp>
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int exitCode = -1;
-  std::string out;
-  std::string err;
-};
-
-CliRun runCli(const std::string& args) {
-  const fs::path errPath = fs::temp_directory_path() / ("clod_query_cli_test_" + std::to_string(::getpid()) + ".err");
-  const std::string command = std::string("\"") + CLOD_CLI_PATH + "\" " + args + " 2>\"" + errPath.string() + "\"";
-  CliRun run;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return run;
-  std::array<char, 4096> buffer;
-  std::size_t n;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.out.append(buffer.data(), n);
-  const int status = ::pclose(pipe);
-  run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  std::ifstream err(errPath);
-  run.err.assign(std::istreambuf_iterator<char>(err), std::istreambuf_iterator<char>());
-  fs::remove(errPath);
-  return run;
-}
+using clod::test::CliRun;
+using clod::test::runCli;
 
 // A cube of half extent 1 as OBJ text (8 vertices, 12 counter-clockwise triangles), baked once.
 class QueryCli : public ::testing::Test {
