@@ -6,7 +6,8 @@
 set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config
   libeigen3-dev libassimp-dev libtbb-dev nlohmann-json3-dev libcli11-dev libqhull-dev libxxhash-dev
-  libgtest-dev libgmock-dev libbenchmark-dev)
+  libgtest-dev libgmock-dev libbenchmark-dev
+  libtinygltf-dev gnuplot-nox chromium)
 for arg in "$@"; do
   case "$arg" in
     --peers) packages+=(libcgal-dev libembree-dev libfcl-dev libbullet-dev libopenvdb-dev) ;;
