@@ -25,6 +25,7 @@ std::string_view errorCodeName(ErrorCode code) noexcept {
     case ErrorCode::kBakeMissingSection: return "bake_missing_section";
     case ErrorCode::kSceneError: return "scene_error";
     case ErrorCode::kSimulationDiverged: return "simulation_diverged";
+    case ErrorCode::kExternalToolFailed: return "external_tool_failed";
   }
   return "unknown_error";
 }
