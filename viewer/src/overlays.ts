@@ -81,11 +81,19 @@ export function makeCells(cells: number[], depthFilter: number | null): { object
   const offsets = new Float32Array(4 * picked.length);
   const colors = new Float32Array(3 * picked.length);
   const c = new THREE.Color();
-  picked.forEach((cell, k) => {
-    offsets.set(cells.slice(5 * cell, 5 * cell + 4), 4 * k);
-    rampColor(maxDepth > 0 ? cells[5 * cell + 4] / maxDepth : 1, c);
-    colors.set([c.r, c.g, c.b], 3 * k);
-  });
+  // One colour per depth, computed once: 10^5 cells then cost a plain copy loop.
+  const ramp = Array.from({ length: maxDepth + 1 }, (_, d) => rampColor(maxDepth > 0 ? d / maxDepth : 1, new THREE.Color()));
+  for (let k = 0; k < picked.length; ++k) {
+    const o = 5 * picked[k];
+    offsets[4 * k] = cells[o];
+    offsets[4 * k + 1] = cells[o + 1];
+    offsets[4 * k + 2] = cells[o + 2];
+    offsets[4 * k + 3] = cells[o + 3];
+    c.copy(ramp[Math.max(0, Math.min(maxDepth, Math.round(cells[o + 4])))]);
+    colors[3 * k] = c.r;
+    colors[3 * k + 1] = c.g;
+    colors[3 * k + 2] = c.b;
+  }
   const geometry = new THREE.InstancedBufferGeometry();
   geometry.setAttribute('position', new THREE.BufferAttribute(kCubeEdges, 3));
   geometry.setAttribute('cell', new THREE.InstancedBufferAttribute(offsets, 4));
@@ -129,7 +137,8 @@ export function makeHalfspaces(cells: number[], halfspaces: number[], depthFilte
   );
   const zAxis = new THREE.Vector3(0, 0, 1);
   const n = new THREE.Vector3(), centre = new THREE.Vector3(), q = new THREE.Quaternion(), s = new THREE.Vector3();
-  const m = new THREE.Matrix4(), color = new THREE.Color();
+  const m = new THREE.Matrix4();
+  const ramp = Array.from({ length: maxDepth + 1 }, (_, d) => rampColor(maxDepth > 0 ? d / maxDepth : 1, new THREE.Color()));
   picked.forEach((i, k) => {
     n.set(halfspaces[4 * i], halfspaces[4 * i + 1], halfspaces[4 * i + 2]);
     const len = n.length();
@@ -142,7 +151,7 @@ export function makeHalfspaces(cells: number[], halfspaces: number[], depthFilte
     const half = cells[5 * i + 3];
     m.compose(centre, q, s.set(half, half, half));
     mesh.setMatrixAt(k, m);
-    mesh.setColorAt(k, rampColor(maxDepth > 0 ? cells[5 * i + 4] / maxDepth : 1, color));
+    mesh.setColorAt(k, ramp[Math.max(0, Math.min(maxDepth, Math.round(cells[5 * i + 4])))]);
   });
   mesh.instanceMatrix.needsUpdate = true;
   if (mesh.instanceColor) mesh.instanceColor.needsUpdate = true;

@@ -190,7 +190,7 @@ export class SceneView {
     this.frameIndex = lo;
     const c = this.folder?.layers?.contacts;
     if (this.contacts && c && lo + 1 < c.frame_offsets.length)
-      this.contacts.show(c.data, c.frame_offsets[lo], c.frame_offsets[lo + 1], 0.06 * this.diagonal);
+      this.contacts.show(c.data, c.frame_offsets[lo], c.frame_offsets[lo + 1], 0.08 * this.diagonal);
     this.dirty = true;
   }
 
@@ -255,24 +255,32 @@ export class SceneView {
     return shown;
   }
 
-  /** Points the camera at everything the animation reaches, from the front-right, above. */
+  /**
+   * Points the camera, from the front-right and above, at everything the moving bodies reach
+   * over the animation (static bodies such as a ground box are context, not the subject), or at
+   * the whole scene when nothing moves.
+   */
   frameCamera(): void {
-    const box = new THREE.Box3();
+    const all = new THREE.Box3(), moving = new THREE.Box3();
     const saved = this.time;
     const steps = Math.min(this.times.length, 64);
     for (let k = 0; k < steps; ++k) {
       this.setTime(this.times[Math.round((k * (this.times.length - 1)) / Math.max(1, steps - 1))]);
-      for (const b of this.bodies) box.expandByObject(b.node);
+      for (const b of this.bodies) {
+        all.expandByObject(b.node);
+        if (!b.isStatic) moving.expandByObject(b.node);
+      }
     }
     this.setTime(saved);
-    if (box.isEmpty()) box.setFromCenterAndSize(new THREE.Vector3(), new THREE.Vector3(1, 1, 1));
-    const centre = box.getCenter(new THREE.Vector3());
-    const radius = Math.max(1e-6, box.getSize(new THREE.Vector3()).length() / 2);
+    if (all.isEmpty()) all.setFromCenterAndSize(new THREE.Vector3(), new THREE.Vector3(1, 1, 1));
+    const subject = moving.isEmpty() ? all : moving;
+    const centre = subject.getCenter(new THREE.Vector3());
+    const radius = Math.max(1e-6, subject.getSize(new THREE.Vector3()).length() / 2);
     this.diagonal = 2 * radius;
-    const distance = (radius / Math.sin(THREE.MathUtils.degToRad(this.camera.fov / 2))) * 0.95;
+    const distance = (radius / Math.sin(THREE.MathUtils.degToRad(this.camera.fov / 2))) * 1.1;
     this.camera.position.copy(centre).add(new THREE.Vector3(0.55, -1.0, 0.45).normalize().multiplyScalar(distance));
     this.camera.near = distance / 200;
-    this.camera.far = distance * 20;
+    this.camera.far = distance * 10 + all.getSize(new THREE.Vector3()).length() * 4;
     this.camera.updateProjectionMatrix();
     this.controls.target.copy(centre);
     this.controls.update();
