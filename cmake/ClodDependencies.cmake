@@ -8,6 +8,7 @@ find_package(Qhull REQUIRED)   # Delaunay tetrahedralisation for the medial-axis
 find_package(Threads REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)  # section checksums of the bake file (XXH3-64)
+find_package(TinyGLTF REQUIRED)  # scene.glb export (src/export)
 
 if(CLOD_BUILD_TESTS)
   find_package(GTest REQUIRED)

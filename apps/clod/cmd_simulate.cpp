@@ -7,6 +7,9 @@
 // "angular_velocity"}], "energy": [per step, kinetic + potential], "budget_spent": [tests per
 // step], "step_seconds": [wall time per step], "tests_total", "left_bounds": [...], ...}). Baked shapes are cached in
 // OUTDIR/bake-cache, so a second run starts at once.
+// With --gltf it also writes OUTDIR/scene.glb and OUTDIR/layers.json (docs/viewer-format.md;
+// simulation_recorder.h: every step, or at most 60 frames per simulated second), and
+// --gltf-layers picks the per-body layers (spheres, cfm, ctree; "none" for frames only).
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
@@ -22,6 +25,7 @@
 #include "clod/atomic_file.h"
 #include "clod/error.h"
 #include "clod/scene.h"
+#include "clod/simulation_recorder.h"
 #include "command.h"
 
 namespace clod::cli {
@@ -33,7 +37,28 @@ struct SimulateOptions {
   std::string model;
   std::optional<std::uint64_t> budget;
   bool progress = false;
+  bool gltf = false;
+  std::string gltfLayers = "spheres,cfm,ctree";
 };
+
+// "spheres,cfm,ctree" (any subset, comma separated) or "none"; anything else is bad usage
+// (kInvalidArgument: exit 2), found before any simulation work.
+BodyLayerOptions parseGltfLayers(const std::string& text) {
+  BodyLayerOptions o;
+  o.sphereTree = o.cfmSamples = o.contactTree = false;
+  if (text == "none") return o;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    if (item == "spheres") o.sphereTree = true;
+    else if (item == "cfm") o.cfmSamples = true;
+    else if (item == "ctree") o.contactTree = true;
+    else
+      throw Error(ErrorCode::kInvalidArgument,
+                  "--gltf-layers: unknown layer '" + item + "' (expected spheres, cfm, ctree, or none)");
+  }
+  return o;
+}
 
 void appendState(std::ostringstream& out, std::uint32_t step, double time, const std::string& name,
                  const RigidBodyState& s) {
@@ -44,6 +69,7 @@ void appendState(std::ostringstream& out, std::uint32_t step, double time, const
 }
 
 int runSimulate(const SimulateOptions& o) {
+  const BodyLayerOptions layerOptions = parseGltfLayers(o.gltfLayers);
   SceneDescription scene = loadScene(o.scene);
   if (!o.model.empty()) scene.world.model = parseContactModel(o.model);
   if (o.budget) scene.world.budgetTests = *o.budget;
@@ -62,6 +88,8 @@ int runSimulate(const SimulateOptions& o) {
   traj << "step,time,body,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n";
   contacts << "step,body_a,body_b,px,py,pz,nx,ny,nz,depth,level\n";
   for (BodyId i = 0; i < world.bodyCount(); ++i) appendState(traj, 0, 0.0, names[i], world.state(i));
+  std::optional<SimulationRecorder> recorder;
+  if (o.gltf) recorder.emplace(world, names, scene.dt, scene.steps);
   nlohmann::json stepSeconds = nlohmann::json::array();
   nlohmann::json energy = nlohmann::json::array(), spent = nlohmann::json::array(), left = nlohmann::json::array();
   std::uint64_t testsTotal = 0, skipped = 0, interrupted = 0;
@@ -72,6 +100,7 @@ int runSimulate(const SimulateOptions& o) {
     const StepReport& r = world.step(scene.dt);
     stepSeconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - stepStart).count());
     const double time = step * scene.dt;
+    if (recorder) recorder->recordStep(step, r);
     for (BodyId i = 0; i < world.bodyCount(); ++i) appendState(traj, step, time, names[i], world.state(i));
     for (std::size_t c = 0; c < r.contacts.size(); ++c) {
       const Contact& k = r.contacts[c];
@@ -128,6 +157,15 @@ int runSimulate(const SimulateOptions& o) {
   writeFileAtomically(out / "contacts.csv", contacts.str());
   writeFileAtomically(out / "summary.json", summary.dump(2) + "\n");
   std::cout << "simulated " << scene.steps << " steps of " << world.bodyCount() << " bodies -> " << o.outDir << "\n";
+  if (recorder) {
+    saveGlb(out / "scene.glb", recorder->gltfScene());
+    writeFileAtomically(out / "layers.json", encodeDebugLayers(recorder->debugLayers(layerOptions)));
+    std::cout << "glTF: scene.glb + layers.json, " << recorder->frameCount() << " frames ("
+              << (recorder->frameStride() == 1 ? std::string("every step")
+                                               : "every " + std::to_string(recorder->frameStride()) +
+                                                     " steps, at most 60 per simulated second")
+              << ")\n";
+  }
   return 0;
 }
 
@@ -139,6 +177,9 @@ const CommandRegistration kRegistration("simulate", [](CLI::App& app) {
   sub->add_option("--contact-model", options->model, "Override: dos, average, cfm, contact-tree, exact");
   sub->add_option("--budget", options->budget, "Override: tests per frame (0 = unlimited)");
   sub->add_flag("--progress", options->progress, "Always show the progress bar on stderr");
+  sub->add_flag("--gltf", options->gltf, "Also write scene.glb (meshes + animation) and layers.json (debug layers)");
+  sub->add_option("--gltf-layers", options->gltfLayers,
+                  "Per-body layers in layers.json: comma list of spheres, cfm, ctree, or none (default: all three)");
   return [options] { return runSimulate(*options); };
 });
 
