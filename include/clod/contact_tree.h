@@ -112,6 +112,23 @@ struct ContactTree {
   std::vector<float> lattice;                ///< 19 values per interior node, see above
   std::vector<ContactHalfSpace> halfSpaces;  ///< one per surface cell
 
+  // --- Derived lookup grid (an accelerator; not stored in the bake file) ----------------------
+  // A dense grid over the cells of depth gridDepth lets sample() start its descent there
+  // instead of at the root, skipping gridDepth dependent loads per query. It is derived from
+  // the arrays above by buildLookupGrid(), which buildContactTree and decodeContactTree call;
+  // without it (gridDepth 0) queries descend from the root and return the same values.
+  std::uint32_t gridDepth = 0;
+  /// (2^gridDepth)^3 entries, x fastest: the node of depth gridDepth covering the grid cell, or
+  /// 0 where the tree ends above gridDepth (such queries descend from the root).
+  std::vector<std::uint32_t> gridNode;
+  /// (2^gridDepth + 1)^3 corner values of the grid cells that exist as nodes (x fastest);
+  /// entries no such node touches are 0 and never read.
+  std::vector<float> gridCorners;
+  /// (Re)derives gridDepth, gridNode and gridCorners from the node arrays: gridDepth is the
+  /// largest d <= 5 with d < depthCount() and 8^d <= nodeCount() / 8, so the grid costs at most
+  /// ~1 byte per node (about 4 % of the tree). O(8^gridDepth). Precondition: a valid tree.
+  void buildLookupGrid();
+
   // --- Size ---------------------------------------------------------------------------------
   std::uint32_t nodeCount() const { return static_cast<std::uint32_t>(firstChild.size()); }
   /// Number of depths present (the deepest leaf's depth + 1); 0 for an empty tree.
@@ -119,7 +136,8 @@ struct ContactTree {
     return levelOffsets.empty() ? 0 : static_cast<std::uint32_t>(levelOffsets.size() - 1);
   }
   bool isLeaf(std::uint32_t node) const { return firstChild[node] == 0; }
-  /// Bytes held by the arrays (excluding vector capacity slack and the struct itself).
+  /// Bytes held by the arrays, lookup grid included (excluding vector capacity slack and the
+  /// struct itself).
   std::size_t memoryBytes() const;
 
   // --- Cell geometry (O(1)) -----------------------------------------------------------------
@@ -169,6 +187,10 @@ struct ContactTree {
   /// errorBound(q) + 2|p - q|, the gradient at q, and insideRoot = false. Never NaN for
   /// finite p; a non-finite p is a precondition violation.
   ContactFieldSample sample(const Vec3& p, std::uint32_t maxDepth = kContactTreeLeafDepth) const;
+
+  /// The cell that sample(p, maxDepth) interpolates in, with its corner values (p clamped to
+  /// the root cube first). O(depth), no allocation. Precondition: p finite.
+  ContactCell cellAt(const Vec3& p, std::uint32_t maxDepth = kContactTreeLeafDepth) const;
 
   /// Just the signed distance of sample(p).
   double distance(const Vec3& p) const { return sample(p).distance; }

@@ -5,6 +5,8 @@
 #include <limits>
 #include <string>
 
+#include <Eigen/Eigenvalues>
+
 #include "clod/error.h"
 
 namespace clod {
@@ -30,9 +32,63 @@ bool insideCell(const ContactTree& tree, const ContactCell& cell, const Vec3& p)
   return (t.array() >= 0.0).all() && (t.array() < 1.0).all();
 }
 
+// Direction of the edge the field of `tree` shows around p (body frame), if it shows one: near
+// a straight edge the distance field is constant along the edge, so every gradient around it is
+// perpendicular to the edge and the gradients span a plane (a face gives one direction, a
+// corner all three). The gradients are taken at p and at p +- rho along each axis; the edge is
+// the eigenvector of the smallest eigenvalue of sum g g^T when that eigenvalue is small and
+// the middle one is not.
+bool edgeDirection(const ContactTree& tree, const Vec3& p, double rho, std::uint32_t maxDepth, Vec3& edge) {
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  int count = 0;
+  for (int k = 0; k < 7; ++k) {
+    Vec3 q = p;
+    if (k > 0) q[(k - 1) / 2] += (k % 2 ? rho : -rho);
+    const Vec3 g = tree.sample(q, maxDepth).gradient;
+    const double length = g.norm();
+    if (!(length > 1e-12)) continue;
+    scatter += (g / length) * (g / length).transpose();
+    ++count;
+  }
+  if (count < 3) return false;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(scatter);
+  const Vec3 lambda = solver.eigenvalues();  // ascending
+  // Two unit gradients 30 degrees apart already give lambda1 / lambda2 ~ 0.07 (of 7 samples);
+  // a third face (a corner) lifts lambda0 toward lambda1.
+  if (!(lambda[1] > 0.05 * lambda[2]) || lambda[0] > 0.2 * lambda[1]) return false;
+  edge = solver.eigenvectors().col(0).normalized();
+  return true;
+}
+
+// Normal out of O toward S at world point pWorld where both bodies show an edge: perpendicular
+// to both edges (the common normal of two crossing segments), oriented along gO - gS (the
+// fields' world gradients: out of O, and into S). Parallel edges leave a whole fan of valid
+// normals; then the bisector gO - gS is used. False when either field shows no clean edge.
+bool edgeEdgeNormal(const ContactTree& treeS, const Vec3& pS, const Pose& xfWorldFromS, double rhoS,
+                    const ContactTree& treeO, const Vec3& pO, const Pose& xfWorldFromO, double rhoO,
+                    std::uint32_t maxDepth, Vec3& normal) {
+  Vec3 edgeS, edgeO;
+  if (!edgeDirection(treeS, pS, rhoS, maxDepth, edgeS) || !edgeDirection(treeO, pO, rhoO, maxDepth, edgeO)) return false;
+  const Vec3 gO = xfWorldFromO.rotation * treeO.sample(pO, maxDepth).gradient.normalized();
+  const Vec3 gS = xfWorldFromS.rotation * treeS.sample(pS, maxDepth).gradient.normalized();
+  const Vec3 bisector = gO - gS;
+  const Vec3 cross = (xfWorldFromS.rotation * edgeS).cross(xfWorldFromO.rotation * edgeO);
+  constexpr double kParallelSin = 0.26;  // edges within 15 degrees count as parallel
+  if (cross.norm() > kParallelSin) {
+    normal = cross.normalized();
+    if (normal.dot(bisector) < 0.0) normal = -normal;
+    return true;
+  }
+  if (!(bisector.norm() > 1e-9)) return false;
+  normal = bisector.normalized();
+  return true;
+}
+
 void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const Pose& xfWorldFromS,
                      const ContactTree& treeO, const ContactCell& cellO, const Pose& xfWorldFromO,
-                     const ContactSamplingSettings& settings, std::vector<ContactPoint>& out) {
+                     const ContactSamplingSettings& settings, std::vector<ContactPoint>& out,
+                     std::uint64_t* edgeEdgeCount) {
   const ContactHalfSpace* hs = treeS.halfSpace(cellS.node);
   if (!hs) return;
   const double h = treeS.cellSize(cellS.depth);
@@ -63,7 +119,18 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
         const double gradientLength = f.gradient.norm();
         if (!(gradientLength > 1e-12)) continue;  // flat interpolant: no direction to push
         Vec3 normal = xfWorldFromO.rotation * (f.gradient / gradientLength);
-        if (normal.dot(-normalWorldS) < conflictCos && flatS) {
+        const bool conflict = normal.dot(-normalWorldS) < conflictCos;
+        // Where our cell holds an edge, or the other field disagrees with our plane, two edges
+        // may be crossing: if both fields show an edge around the sample, neither gradient
+        // alone is the contact normal (each leans toward one of its faces), the common
+        // perpendicular of the edges is. The gradients must be probed on both sides of each
+        // edge's kink (the leaves there may lie on one side), so the probe radius is twice the
+        // larger of the two cells.
+        const double rho = 2.0 * std::max(h, treeO.cellSize(f.depth));
+        if (settings.edgeEdgeNormals && (conflict || !flatS) &&
+            edgeEdgeNormal(treeS, pS, xfWorldFromS, rho, treeO, pO, xfWorldFromO, rho, settings.maxDepth, normal)) {
+          if (edgeEdgeCount) ++*edgeEdgeCount;
+        } else if (conflict && flatS) {
           // The other body shows an edge or corner here while our cell is a flat face: an edge
           // or vertex on a face pushes along the face normal, not along the rounded field.
           const ContactHalfSpace* ho = treeO.halfSpace(f.node);
@@ -87,23 +154,45 @@ struct Traversal {
   bool leafA(const ContactCell& c) const { return a.isLeaf(c.node) || c.depth >= settings.maxDepth; }
   bool leafB(const ContactCell& c) const { return b.isLeaf(c.node) || c.depth >= settings.maxDepth; }
 
+  // True when the sphere (world centre, radius) lies on the outer side of the half-space of
+  // `leaf` farther than the margin plus the plane's fit error: then neither the leaf's samples
+  // (on or below the plane) nor its field (>= plane distance - fitError in the cell, see the
+  // setting's documentation) can produce a contact inside the sphere. The 1e-6 h slack covers
+  // the float rounding of the stored plane.
+  bool outsideLeafPlane(const ContactTree& tree, const ContactCell& leaf, const Pose& xf, const Vec3& centreWorld,
+                        double radius) const {
+    const ContactHalfSpace* hs = tree.halfSpace(leaf.node);
+    if (!hs) return false;
+    const Vec3 n(hs->normal[0], hs->normal[1], hs->normal[2]);
+    const double h = tree.cellSize(leaf.depth);
+    const double above = n.dot(xf.applyInverse(centreWorld) - tree.cellCenter(leaf)) - double(hs->offset);
+    return above > radius + double(hs->fitError) + settings.marginAbs + 1e-6 * h;
+  }
+
   void visit(const ContactCell& ca, const ContactCell& cb) {
     ++stats.cellPairsVisited;
     // Every sample lies in one cell of each tree, so only sphere pairs that touch can share one.
     const Vec3 centreA = xfA.apply(a.cellCenter(ca));
     const Vec3 centreB = xfB.apply(b.cellCenter(cb));
-    const double radii = a.cellRadius(ca.depth) + b.cellRadius(cb.depth);
+    const double radiusA = a.cellRadius(ca.depth), radiusB = b.cellRadius(cb.depth);
+    const double radii = radiusA + radiusB;
     if ((centreA - centreB).squaredNorm() > radii * radii) return;
     const bool la = leafA(ca), lb = leafB(cb);
+    // Paper B: leaf spheres are loose over flat regions, so a leaf's half-space keeps pruning.
+    if (settings.leafHalfSpacePruning &&
+        ((la && outsideLeafPlane(a, ca, xfA, centreB, radiusB)) || (lb && outsideLeafPlane(b, cb, xfB, centreA, radiusA)))) {
+      ++stats.halfSpacePrunes;
+      return;
+    }
     if (la && lb) {
       if (a.halfSpace(ca.node)) {
         ++stats.cellPairsSampled;
-        sampleUnchecked(a, ca, xfA, b, cb, xfB, settings, out);
+        sampleUnchecked(a, ca, xfA, b, cb, xfB, settings, out, &stats.edgeEdgeNormals);
       }
       if (b.halfSpace(cb.node)) {
         ++stats.cellPairsSampled;
         const std::size_t first = out.size();
-        sampleUnchecked(b, cb, xfB, a, ca, xfA, settings, out);
+        sampleUnchecked(b, cb, xfB, a, ca, xfA, settings, out, &stats.edgeEdgeNormals);
         for (std::size_t i = first; i < out.size(); ++i) {
           out[i].normal = -out[i].normal;  // the convention is "out of B toward A"
           out[i].sampledBody = 1;
@@ -133,7 +222,7 @@ void sampleCellPair(const ContactTree& treeS, const ContactCell& cellS, const Po
                     const ContactTree& treeO, const ContactCell& cellO, const Pose& xfWorldFromO,
                     const ContactSamplingSettings& settings, std::vector<ContactPoint>& out) {
   checkSettings(settings);
-  sampleUnchecked(treeS, cellS, xfWorldFromS, treeO, cellO, xfWorldFromO, settings, out);
+  sampleUnchecked(treeS, cellS, xfWorldFromS, treeO, cellO, xfWorldFromO, settings, out, nullptr);
 }
 
 void findContacts(const ContactTree& treeA, const Pose& xfWorldFromA, const ContactTree& treeB,

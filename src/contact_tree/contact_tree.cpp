@@ -33,7 +33,37 @@ double interpolateTrilinear(const std::array<float, 8>& c, const Vec3& t, Vec3* 
 std::size_t ContactTree::memoryBytes() const {
   return firstChild.size() * sizeof(std::uint32_t) + errorBound.size() * sizeof(float) +
          halfSpaceIndex.size() * sizeof(std::uint32_t) + levelOffsets.size() * sizeof(std::uint32_t) +
-         lattice.size() * sizeof(float) + halfSpaces.size() * sizeof(ContactHalfSpace) + sizeof(rootCorners);
+         lattice.size() * sizeof(float) + halfSpaces.size() * sizeof(ContactHalfSpace) + sizeof(rootCorners) +
+         gridNode.size() * sizeof(std::uint32_t) + gridCorners.size() * sizeof(float);
+}
+
+void ContactTree::buildLookupGrid() {
+  gridDepth = 0;
+  gridNode.clear();
+  gridCorners.clear();
+  std::uint32_t d = 0;
+  while (d < 5 && d + 1 < depthCount() && (std::uint64_t{1} << (3 * (d + 1))) <= nodeCount() / 8) ++d;
+  if (d == 0) return;
+  gridDepth = d;
+  const std::uint32_t n = 1u << d, m = n + 1;
+  gridNode.assign(std::size_t{n} * n * n, 0);
+  gridCorners.assign(std::size_t{m} * m * m, 0.0f);
+  // Depth-first walk over the cells down to depth d; O(8^d).
+  ContactCell stack[6 * 8];
+  int top = 0;
+  stack[top++] = rootCell();
+  while (top > 0) {
+    const ContactCell cell = stack[--top];
+    if (cell.depth == d) {
+      const auto& i = cell.index;
+      gridNode[i[0] + n * (i[1] + std::size_t{n} * i[2])] = cell.node;
+      for (std::uint32_t c = 0; c < 8; ++c)
+        gridCorners[(i[0] + (c & 1)) + m * ((i[1] + ((c >> 1) & 1)) + std::size_t{m} * (i[2] + (c >> 2)))] = cell.corners[c];
+      continue;
+    }
+    if (isLeaf(cell.node)) continue;
+    for (std::uint32_t o = 0; o < 8; ++o) stack[top++] = childCell(cell, o);
+  }
 }
 
 ContactCell ContactTree::rootCell() const {
@@ -54,6 +84,23 @@ ContactCell ContactTree::childCell(const ContactCell& cell, std::uint32_t octant
   for (int c = 0; c < 8; ++c) child.corners[c] = pool[kChildCornerSlot[octant][c]];
   child.corners[octant] = cell.corners[octant];
   return child;
+}
+
+ContactCell ContactTree::cellAt(const Vec3& p, std::uint32_t maxDepthQuery) const {
+  CLOD_ASSERT(!firstChild.empty() && p.allFinite());
+  const Vec3 u = ((p - origin) / rootSize).cwiseMax(0.0).cwiseMin(1.0);
+  ContactCell cell = rootCell();
+  while (cell.depth < maxDepthQuery && !isLeaf(cell.node)) {
+    std::uint32_t octant = 0;
+    const double cells = static_cast<double>(1u << (cell.depth + 1));
+    for (int a = 0; a < 3; ++a) {
+      // Half-open cells, the upper root faces belong to the last cell (as in sample()).
+      const double x = std::min(u[a] * cells, cells - 0.5);
+      if (static_cast<std::uint32_t>(x) > 2 * cell.index[a]) octant |= 1u << a;
+    }
+    cell = childCell(cell, octant);
+  }
+  return cell;
 }
 
 double ContactTree::minDistance(const ContactCell& cell) const {
@@ -88,10 +135,24 @@ ContactFieldSample ContactTree::sample(const Vec3& p, std::uint32_t maxDepthQuer
   // the parent's block unless c == o, in which case it is the parent's own corner c -- so each
   // corner is found by walking back to the deepest level whose octant differs (1 step in 7 of
   // 8 cases), instead of copying 8 values at every level.
+  //
+  // The descent is a chain of dependent loads (firstChild of the next level needs this one's),
+  // so its cost is memory latency, not arithmetic. Two things shorten the chain: the lookup
+  // grid replaces the top gridDepth levels by one load, and each level's lattice block is
+  // prefetched as soon as its address is known, so the final corner loads overlap the last
+  // firstChild load instead of following it.
   const float* blocks[32];
   std::uint8_t octants[32];
   std::uint32_t node = 0;
   std::uint32_t depth = 0;
+  std::uint32_t startDepth = 0;
+  std::size_t gridCell = 0;
+  if (gridDepth != 0 && maxDepthQuery >= gridDepth) {
+    const std::uint32_t shift = 31 - gridDepth;
+    gridCell = (fixed[0] >> shift) + ((std::size_t{fixed[1] >> shift} + (std::size_t{fixed[2] >> shift} << gridDepth)) << gridDepth);
+    const std::uint32_t start = gridNode[gridCell];
+    if (start != 0) node = start, depth = startDepth = gridDepth;
+  }
   const std::uint32_t* children = firstChild.data();
   const float* pool = lattice.data();
   while (depth < maxDepthQuery) {
@@ -101,15 +162,27 @@ ContactFieldSample ContactTree::sample(const Vec3& p, std::uint32_t maxDepthQuer
     const std::uint32_t octant =
         ((fixed[0] >> bit) & 1u) | (((fixed[1] >> bit) & 1u) << 1) | (((fixed[2] >> bit) & 1u) << 2);
     ++depth;
-    blocks[depth] = pool + std::size_t{(first - 1) >> 3} * kContactTreeLatticePerNode;
+    const float* block = pool + std::size_t{(first - 1) >> 3} * kContactTreeLatticePerNode;
+    __builtin_prefetch(block);
+    __builtin_prefetch(block + kContactTreeLatticePerNode - 1);
+    blocks[depth] = block;
     octants[depth] = static_cast<std::uint8_t>(octant);
     node = first + octant;
   }
   std::array<float, 8> corners;
   for (std::uint32_t c = 0; c < 8; ++c) {
     std::uint32_t level = depth;
-    while (level > 0 && octants[level] == c) --level;
-    corners[c] = level == 0 ? rootCorners[c] : blocks[level][kChildCornerSlot[octants[level]][c]];
+    while (level > startDepth && octants[level] == c) --level;
+    if (level > startDepth) {
+      corners[c] = blocks[level][kChildCornerSlot[octants[level]][c]];
+    } else if (startDepth == 0) {
+      corners[c] = rootCorners[c];
+    } else {
+      // Corner c of the grid cell (rare: every octant below the grid equals c).
+      const std::size_t n = std::size_t{1} << gridDepth, m = n + 1;
+      const std::size_t ix = gridCell % n, iy = (gridCell / n) % n, iz = gridCell / (n * n);
+      corners[c] = gridCorners[(ix + (c & 1)) + m * ((iy + ((c >> 1) & 1)) + m * (iz + (c >> 2)))];
+    }
   }
   const double cells = static_cast<double>(1u << depth);
   Vec3 t;

@@ -6,6 +6,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include "clod/error.h"
 #include "clod/proximity.h"
@@ -59,6 +60,19 @@ void checkSettings(const ContactTreeSettings& s) {
     bad("discontinuityStopRel " + std::to_string(s.discontinuityStopRel) + " must be finite and >= 0");
 }
 
+// A shared lattice point of one level: its position on the level's half-cell lattice (packed)
+// and who asked for it. Sorting by (key, cell) makes the lowest-numbered cell the owner that
+// evaluates it, whatever the thread count.
+struct LatticeRequest {
+  std::uint64_t key;
+  std::uint32_t cell;  // index into the chunk
+  std::uint32_t lattice;
+  bool operator<(const LatticeRequest& o) const { return key != o.key ? key < o.key : cell < o.cell; }
+};
+// Cells measured together; the frontier is in Morton order (children are appended in parent
+// and octant order), so most neighbours share a chunk. Bounds the request buffer (~18 MB).
+constexpr std::size_t kChunkCells = 1u << 16;
+
 class Builder {
 public:
   Builder(const MeshDistance& distance, const ContactTreeSettings& settings) : distance_(distance), settings_(settings) {}
@@ -66,19 +80,30 @@ public:
   ContactTree build(ContactTreeBuildStats* stats);
 
 private:
-  void processCell(const PendingCell& cell, std::uint32_t depth, CellResult& result) const;
+  // True when the cell must be measured; otherwise fills r as a proven-far leaf.
+  bool needsMeasuring(const PendingCell& cell, std::uint32_t depth, CellResult& r) const;
+  // Exact signed distance at local position t (cell units) of `cell`, see the sign inference.
+  MeshDistance::Signed exactQuery(const PendingCell& cell, std::uint32_t depth, const Vec3& t) const;
+  // The rest of the refinement test, given the exact values at the cell's 18 shared lattice
+  // points (exact[l] for lattice index l, corners and the centre excluded).
+  void measureCell(const PendingCell& cell, std::uint32_t depth, double* exact, CellResult& r) const;
+  // Measures frontier[begin, end) (the cells with results[i].measured): evaluates each distinct
+  // shared lattice point once, then runs measureCell per cell. Returns the number of shared
+  // lattice evaluations.
+  std::uint64_t measureChunk(const std::vector<PendingCell>& frontier, std::size_t begin, std::size_t end,
+                             std::uint32_t depth, std::vector<CellResult>& results);
 
   const MeshDistance& distance_;
   const ContactTreeSettings& settings_;
   ContactTree tree_;
+  std::vector<double> exactScratch_;
+  std::vector<LatticeRequest> requests_;
+  std::vector<std::size_t> groupStarts_;
 };
 
-void Builder::processCell(const PendingCell& cell, std::uint32_t depth, CellResult& r) const {
+bool Builder::needsMeasuring(const PendingCell& cell, std::uint32_t depth, CellResult& r) const {
   const double h = tree_.cellSize(depth);
   const double diagonal = kSqrt3 * h;
-  const double band = tree_.bandAbs;
-  const Vec3 cellMin = tree_.origin + h * Vec3(cell.index[0], cell.index[1], cell.index[2]);
-
   float minAbs = std::abs(cell.corners[0]);
   bool sameSign = true;
   for (int c = 1; c < 8; ++c) {
@@ -89,49 +114,86 @@ void Builder::processCell(const PendingCell& cell, std::uint32_t depth, CellResu
   // |d(x)| >= |d(c)| - diagonal/2. If all corners exceed band + diagonal/2 (same sign), no
   // point of the cell is in the band and the surface does not cross it. The relative slack
   // covers the float rounding of the corner values.
-  if (sameSign && double(minAbs) * (1.0 - 1e-6) > band + 0.5 * diagonal) {
+  if (sameSign && double(minAbs) * (1.0 - 1e-6) > tree_.bandAbs + 0.5 * diagonal) {
     // Rigorous for any 1-Lipschitz field: |d(x) - sum w_i d(c_i)| <= sum w_i |x - c_i| <=
     // sqrt(sum w_i |x - c_i|^2) = h sqrt(sum_axes t(1-t)) <= h sqrt(3)/2.
     r.error = static_cast<float>(0.5 * diagonal);
-    return;
+    return false;
   }
-
-  // Exact values at the 27 lattice points (8 known) and at the 8 octant centres.
   r.measured = true;
-  // Exact signed distance at local position t (in cell units). The sign is the expensive part
-  // of an exact query for open meshes (a winding number), and often it is already known: if a
-  // corner value v has |v| > |x - corner|, d(x) has v's sign, since |d(x) - v| <= |x - corner|.
-  // Then only the unsigned distance is needed.
-  auto exactQuery = [&](const Vec3& t) -> MeshDistance::Signed {
-    const Vec3 p = cellMin + h * t;
-    ++r.queries;
-    for (int c = 0; c < 8; ++c) {
-      const double reach = h * (t - Vec3(c & 1, (c >> 1) & 1, (c >> 2) & 1)).norm();
-      const double v = cell.corners[c];
-      if (std::abs(v) * (1.0 - 1e-6) > reach + 1e-9 * h) {
-        const ClosestPoint closest = distance_.closestPoint(p);
-        return {closest, v < 0.0 ? -closest.distance : closest.distance};
-      }
-    }
-    return distance_.signedQuery(p);
-  };
-  auto exactAt = [&](const Vec3& t) { return exactQuery(t).signedDistance; };
-  double exact[kLatticeSize];
-  MeshDistance::Signed centre{};
-  for (int l = 0; l < kLatticeSize; ++l) {
-    const int i = l % 3, j = (l / 3) % 3, k = l / 9;
-    if (kLatticeSlot[l] < 0) {
-      const int c = (i / 2) | ((j / 2) << 1) | ((k / 2) << 2);
-      exact[l] = cell.corners[c];
-      continue;
-    }
-    if (l == 13) {
-      centre = exactQuery(0.5 * Vec3(i, j, k));
-      exact[l] = centre.signedDistance;
-    } else {
-      exact[l] = exactAt(0.5 * Vec3(i, j, k));
+  return true;
+}
+
+MeshDistance::Signed Builder::exactQuery(const PendingCell& cell, std::uint32_t depth, const Vec3& t) const {
+  // The sign is the expensive part of an exact query for open meshes (a winding number), and
+  // often it is already known: if a corner value v has |v| > |x - corner|, d(x) has v's sign,
+  // since |d(x) - v| <= |x - corner|. Then only the unsigned distance is needed.
+  const double h = tree_.cellSize(depth);
+  const Vec3 p = tree_.origin + h * (Vec3(cell.index[0], cell.index[1], cell.index[2]) + t);
+  for (int c = 0; c < 8; ++c) {
+    const double reach = h * (t - Vec3(c & 1, (c >> 1) & 1, (c >> 2) & 1)).norm();
+    const double v = cell.corners[c];
+    if (std::abs(v) * (1.0 - 1e-6) > reach + 1e-9 * h) {
+      const ClosestPoint closest = distance_.closestPoint(p);
+      return {closest, v < 0.0 ? -closest.distance : closest.distance};
     }
   }
+  return distance_.signedQuery(p);
+}
+
+std::uint64_t Builder::measureChunk(const std::vector<PendingCell>& frontier, std::size_t begin, std::size_t end,
+                                    std::uint32_t depth, std::vector<CellResult>& results) {
+  // A face centre is shared by 2 cells, an edge midpoint by 4: near the surface, where most
+  // cells are measured, each distinct point is evaluated once instead of 19 times per cell,
+  // roughly halving the exact queries (docs/contact-tree.md).
+  const std::size_t count = end - begin;
+  exactScratch_.resize(count * kLatticeSize);
+  requests_.clear();
+  // Lattice coordinates at depth + 1 are <= 2^21, so (2^21 + 1)^3 < 2^64 keys are unique.
+  constexpr std::uint64_t kSpan = (std::uint64_t{1} << 21) + 1;
+  for (std::size_t i = 0; i < count; ++i) {
+    if (!results[begin + i].measured) continue;
+    const PendingCell& cell = frontier[begin + i];
+    for (int l = 0; l < kLatticeSize; ++l) {
+      if (kLatticeSlot[l] < 0 || l == 13) continue;
+      const std::uint64_t x = 2ull * cell.index[0] + l % 3, y = 2ull * cell.index[1] + (l / 3) % 3, z = 2ull * cell.index[2] + l / 9;
+      requests_.push_back({x + kSpan * (y + kSpan * z), static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(l)});
+    }
+  }
+  tbb::parallel_sort(requests_.begin(), requests_.end());
+  groupStarts_.clear();
+  for (std::size_t r = 0; r < requests_.size(); ++r)
+    if (r == 0 || requests_[r].key != requests_[r - 1].key) groupStarts_.push_back(r);
+  groupStarts_.push_back(requests_.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groupStarts_.size() - 1, 64), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t g = range.begin(); g != range.end(); ++g) {
+      const LatticeRequest& owner = requests_[groupStarts_[g]];
+      const int l = static_cast<int>(owner.lattice);
+      const double value = exactQuery(frontier[begin + owner.cell], depth, 0.5 * Vec3(l % 3, (l / 3) % 3, l / 9)).signedDistance;
+      for (std::size_t r = groupStarts_[g]; r < groupStarts_[g + 1]; ++r)
+        exactScratch_[std::size_t{requests_[r].cell} * kLatticeSize + requests_[r].lattice] = value;
+    }
+  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 8), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i)
+      if (results[begin + i].measured) measureCell(frontier[begin + i], depth, exactScratch_.data() + i * kLatticeSize, results[begin + i]);
+  });
+  return groupStarts_.size() - 1;
+}
+
+void Builder::measureCell(const PendingCell& cell, std::uint32_t depth, double* exact, CellResult& r) const {
+  const double h = tree_.cellSize(depth);
+  const double diagonal = kSqrt3 * h;
+  const double band = tree_.bandAbs;
+  const Vec3 cellMin = tree_.origin + h * Vec3(cell.index[0], cell.index[1], cell.index[2]);
+  auto exactAt = [&](const Vec3& t) {
+    ++r.queries;
+    return exactQuery(cell, depth, t).signedDistance;
+  };
+  for (int c = 0; c < 8; ++c) exact[detail::parentCornerLattice(c)] = cell.corners[c];
+  ++r.queries;
+  const MeshDistance::Signed centre = exactQuery(cell, depth, Vec3::Constant(0.5));
+  exact[13] = centre.signedDistance;
   // Interpolation error at the test points, overall and restricted to the band. A band point
   // is within 0.28 h of a test point (covering radius of this body-centred lattice), so a
   // test point counts for the band if |d| <= band + h/2.
@@ -228,9 +290,11 @@ ContactTree Builder::build(ContactTreeBuildStats* stats) {
   tree_.levelOffsets.push_back(0);
   for (std::uint32_t depth = 0; !frontier.empty(); ++depth) {
     results.assign(frontier.size(), CellResult{});
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, frontier.size(), 8), [&](const tbb::blocked_range<std::size_t>& range) {
-      for (std::size_t i = range.begin(); i != range.end(); ++i) processCell(frontier[i], depth, results[i]);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, frontier.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
+      for (std::size_t i = range.begin(); i != range.end(); ++i) needsMeasuring(frontier[i], depth, results[i]);
     });
+    for (std::size_t begin = 0; begin < frontier.size(); begin += kChunkCells)
+      st.distanceQueries += measureChunk(frontier, begin, std::min(frontier.size(), begin + kChunkCells), depth, results);
     // Link serially in frontier order: children are appended in the same order as their
     // parents, which keeps the layout breadth-first and independent of scheduling.
     next.clear();
@@ -271,6 +335,7 @@ ContactTree Builder::build(ContactTreeBuildStats* stats) {
   st.nodes = tree_.nodeCount();
   st.surfaceCells = tree_.halfSpaces.size();
   if (stats) *stats = st;
+  tree_.buildLookupGrid();
   return std::move(tree_);
 }
 

@@ -104,6 +104,7 @@ ContactTree decodeContactTree(ByteReader& in) {
     if (!(std::abs(len - 1.0) < 1e-3) || !std::isfinite(hs.offset) || !(std::isfinite(hs.fitError) && hs.fitError >= 0.0f))
       fail("halfSpaces[" + std::to_string(i) + "] is not a unit normal with finite offset and fit error");
   }
+  tree.buildLookupGrid();
   return tree;
 }
 

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <tuple>
 
 #include "clod/contact_sampling.h"
 #include "clod/contact_tree_builder.h"
@@ -128,6 +130,101 @@ TEST(ContactSampling, DeeplyInterpenetratingBoxesStillGetContacts) {
   // Inside, the coarse field's gradient turns between faces near the medial surfaces, so there
   // are more patches than faces, but thinning must still remove the bulk of the samples.
   EXPECT_LE(contacts.size() * 10, stats.rawContacts) << contacts.size() << " of " << stats.rawContacts;
+}
+
+// Two boxes crossed edge-on: B (the 1-box) turned 45 degrees about y, so its top edge runs
+// along y at height sqrt(2); A (the 0.5-box) turned 45 degrees about x (then yawed), so its
+// bottom edge is horizontal, sunk `penetration` below B's edge. Two crossing edges touch along
+// their common perpendicular, which is +z here whatever the yaw: the analytic normal.
+struct CrossedEdges {
+  Pose poseA, poseB;
+};
+CrossedEdges crossedEdges(double yaw, double penetration) {
+  CrossedEdges c;
+  c.poseB.rotation = Quat(Eigen::AngleAxisd(kPi / 4.0, Vec3::UnitY()));
+  c.poseA.rotation = Quat(Eigen::AngleAxisd(yaw, Vec3::UnitZ())) * Quat(Eigen::AngleAxisd(kPi / 4.0, Vec3::UnitX()));
+  c.poseA.translation = Vec3(0.0, 0.0, std::sqrt(2.0) * (boxes().halfB.x() + boxes().halfA.y()) - penetration);
+  return c;
+}
+
+void expectEdgeEdgeNormalsVertical(double yaw) {
+  // Deeper than both trees' eps_s (3.5e-3 and 6.9e-3), so the overlap is resolved by the fields.
+  const double penetration = 1e-2;
+  const CrossedEdges pose = crossedEdges(yaw, penetration);
+  std::vector<ContactPoint> contacts;
+  ContactQueryStats stats;
+  findContacts(boxes().treeA, pose.poseA, boxes().treeB, pose.poseB, ContactSamplingSettings{}, contacts, &stats);
+  ASSERT_FALSE(contacts.empty());
+  EXPECT_GT(stats.edgeEdgeNormals, 0u);
+  const Vec3 crossing(0.0, 0.0, std::sqrt(2.0) * boxes().halfB.x());
+  for (const ContactPoint& c : contacts) {
+    // 1 degree, as for faces: both box fields are exactly invariant along their edges (in the
+    // box frames), so the estimated edge directions are exact up to float rounding.
+    EXPECT_GT(c.normal.z(), std::cos(kPi / 180.0)) << "normal " << c.normal.transpose() << " at " << c.point.transpose();
+    // The overlap is a tiny tetrahedron at the crossing; no contact may be deeper than the
+    // penetration (plus both trees' eps) or far from it.
+    EXPECT_LE(c.depth, penetration + boxes().treeA.errorAbs + boxes().treeB.errorAbs);
+    EXPECT_LT((c.point - crossing).norm(), 0.05);
+  }
+}
+
+TEST(ContactSampling, CrossedEdgesGetTheCommonPerpendicularAsNormal) { expectEdgeEdgeNormalsVertical(0.0); }
+
+TEST(ContactSampling, SkewCrossedEdgesGetTheCommonPerpendicularAsNormal) { expectEdgeEdgeNormalsVertical(kPi / 6.0); }
+
+TEST(ContactSampling, OneFieldGradientAloneTiltsCrossedEdgeNormals) {
+  // Shows what the edge-edge rule repairs (and that the test above can fail): with it off,
+  // the gradient of one body's field near its edge leans toward one of its faces.
+  const CrossedEdges pose = crossedEdges(0.0, 1e-2);
+  ContactSamplingSettings settings;
+  settings.edgeEdgeNormals = false;
+  std::vector<ContactPoint> contacts;
+  findContacts(boxes().treeA, pose.poseA, boxes().treeB, pose.poseB, settings, contacts);
+  ASSERT_FALSE(contacts.empty());
+  double worst = 1.0;
+  for (const ContactPoint& c : contacts) worst = std::min(worst, c.normal.z());
+  EXPECT_LT(worst, std::cos(10.0 * kPi / 180.0));
+}
+
+// Leaf half-space pruning must only skip pairs that cannot produce a contact: the raw samples
+// of the unpruned traversal (the oracle) are reproduced exactly, with fewer pairs visited.
+void expectPruningChangesNothing(const ContactTree& a, const Pose& poseA, const ContactTree& b, const Pose& poseB,
+                                 double margin) {
+  ContactSamplingSettings on, off;
+  on.marginAbs = off.marginAbs = margin;
+  off.leafHalfSpacePruning = false;
+  on.maxContactsPerPatch = off.maxContactsPerPatch = 1u << 30;  // no thinning: compare every sample
+  std::vector<ContactPoint> withPruning, without;
+  ContactQueryStats statsOn, statsOff;
+  findContacts(a, poseA, b, poseB, on, withPruning, &statsOn);
+  findContacts(a, poseA, b, poseB, off, without, &statsOff);
+  ASSERT_FALSE(without.empty());
+  ASSERT_EQ(withPruning.size(), without.size());
+  auto key = [](const ContactPoint& c) { return std::make_tuple(c.point.x(), c.point.y(), c.point.z(), c.sampledBody); };
+  auto byKey = [&](const ContactPoint& x, const ContactPoint& y) { return key(x) < key(y); };
+  std::sort(withPruning.begin(), withPruning.end(), byKey);
+  std::sort(without.begin(), without.end(), byKey);
+  for (std::size_t i = 0; i < without.size(); ++i) {
+    ASSERT_EQ(withPruning[i].point, without[i].point);
+    ASSERT_EQ(withPruning[i].normal, without[i].normal);
+    ASSERT_EQ(withPruning[i].depth, without[i].depth);
+  }
+  EXPECT_GT(statsOn.halfSpacePrunes, 0u);
+  EXPECT_EQ(statsOff.halfSpacePrunes, 0u);
+  EXPECT_LT(statsOn.cellPairsVisited, statsOff.cellPairsVisited);
+}
+
+TEST(ContactSampling, LeafHalfSpacePruningKeepsEverySampleOfRestingBoxes) {
+  expectPruningChangesNothing(boxes().treeA, restingPose(0.3, -0.2, 0.5, 1e-3), boxes().treeB, Pose{}, 0.0);
+}
+
+TEST(ContactSampling, LeafHalfSpacePruningKeepsEverySampleWithAMargin) {
+  expectPruningChangesNothing(boxes().treeA, restingPose(0.1, 0.1, 0.2, -5e-3), boxes().treeB, Pose{}, 0.01);
+}
+
+TEST(ContactSampling, LeafHalfSpacePruningKeepsEverySampleOfCrossedEdges) {
+  const CrossedEdges pose = crossedEdges(kPi / 6.0, 1e-2);
+  expectPruningChangesNothing(boxes().treeA, pose.poseA, boxes().treeB, pose.poseB, 0.0);
 }
 
 TEST(ContactReduction, PlanarGridKeepsItsFourCorners) {

@@ -53,6 +53,41 @@ BandComparison compareInBand(const test::BuiltTree& built, std::uint32_t count, 
   return out;
 }
 
+TEST_P(ContactTreeOnSharedMesh, LookupGridGivesTheSameAnswersAsDescendingFromTheRoot) {
+  // The grid is an accelerator only: the same tree without it (queries from the root, the
+  // plain definition) must give bit-identical samples, at every depth, inside and outside.
+  const auto& built = sharedTree(GetParam());
+  ASSERT_GT(built.tree.gridDepth, 0u);
+  ContactTree plain = built.tree;
+  plain.gridDepth = 0;
+  plain.gridNode.clear();
+  plain.gridCorners.clear();
+  const TriangleMesh& mesh = built.exact->mesh();
+  const auto prefix = test::areaPrefix(mesh);
+  std::mt19937_64 rng(77);
+  std::uniform_real_distribution<double> uni(-0.1, 1.1);
+  const std::uint32_t count = test::sanitizerScale() ? 2'000 : 20'000;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const Vec3 p = i % 2 ? test::randomBandPoint(mesh, prefix, built.tree.bandAbs, rng)
+                         : built.tree.origin + built.tree.rootSize * Vec3(uni(rng), uni(rng), uni(rng));
+    for (std::uint32_t depth : {kContactTreeLeafDepth, built.tree.gridDepth, built.tree.gridDepth + 2, 1u}) {
+      const ContactFieldSample x = built.tree.sample(p, depth), y = plain.sample(p, depth);
+      ASSERT_EQ(x.distance, y.distance) << p.transpose() << " depth " << depth;
+      ASSERT_EQ(x.gradient, y.gradient);
+      ASSERT_EQ(x.node, y.node);
+      ASSERT_EQ(x.depth, y.depth);
+      ASSERT_EQ(x.errorBound, y.errorBound);
+      // cellAt finds the same cell, with corners whose interpolation is the sample.
+      const ContactCell cell = built.tree.cellAt(p, depth);
+      ASSERT_EQ(cell.node, x.node);
+      const Vec3 t = ((p - built.tree.cellMin(cell)) / built.tree.cellSize(cell.depth)).cwiseMax(0.0).cwiseMin(1.0);
+      if (x.insideRoot) {
+        ASSERT_NEAR(interpolateTrilinear(cell.corners, t, nullptr), x.distance, 1e-12 * built.tree.rootSize);
+      }
+    }
+  }
+}
+
 TEST_P(ContactTreeOnSharedMesh, DistanceInBandIsWithinEpsOfExactSignedDistance) {
   const auto& built = sharedTree(GetParam());
   const std::uint32_t count = test::sanitizerScale() ? 10'000 : 100'000;
