@@ -60,6 +60,24 @@ public:
     return {faceNormals_.data() + faceNormalOffsets_[sphere], faceNormalOffsets_[sphere + 1] - faceNormalOffsets_[sphere]};
   }
   static constexpr std::uint32_t kMaxSphereFaceNormals = 8;
+  /// The distinct vertex indices (into mesh().vertices, ascending) of the triangles sphere
+  /// `sphere` is responsible for and of their edge neighbours with the same face normal (a face
+  /// split into triangles counts whole up to one ring), when the sphere is a faceted patch (sphereFaceNormals non-empty)
+  /// with at most kMaxSpherePatchVertices of them; empty otherwise. The cfm model uses them as a
+  /// support function of the patch (max of n . v over them), together with the sphere itself, to
+  /// pick the normal along which two faceted patches overlap least (docs/narrow-phase.md).
+  std::span<const std::uint32_t> spherePatchVertices(std::uint32_t sphere) const noexcept {
+    return {patchVertices_.data() + patchVertexOffsets_[sphere], patchVertexOffsets_[sphere + 1] - patchVertexOffsets_[sphere]};
+  }
+  static constexpr std::uint32_t kMaxSpherePatchVertices = 32;
+  /// For a sphere with patch vertices: the distinct directions (unit, sign arbitrary) of the body
+  /// edges among its triangles' edges (sharp: the neighbour's normal differs; or a border), when
+  /// there are at most kMaxSphereEdgeDirections; empty otherwise. The cfm model crosses them with
+  /// the other patch's to get edge-edge separating axes.
+  std::span<const Vec3f> sphereEdgeDirections(std::uint32_t sphere) const noexcept {
+    return {edgeDirections_.data() + edgeDirectionOffsets_[sphere], edgeDirectionOffsets_[sphere + 1] - edgeDirectionOffsets_[sphere]};
+  }
+  static constexpr std::uint32_t kMaxSphereEdgeDirections = 6;
 
   /// Bounding-box diagonal of the mesh: the unit of this body's relative tolerances.
   double diagonal() const noexcept { return diagonal_; }
@@ -75,6 +93,10 @@ private:
   std::vector<std::uint32_t> sphereLevel_;
   std::vector<std::uint32_t> faceNormalOffsets_;
   std::vector<Vec3f> faceNormals_;
+  std::vector<std::uint32_t> patchVertexOffsets_;
+  std::vector<std::uint32_t> patchVertices_;
+  std::vector<std::uint32_t> edgeDirectionOffsets_;
+  std::vector<Vec3f> edgeDirections_;
   double diagonal_ = 0.0;
   std::string name_;
 };

@@ -1,5 +1,6 @@
 #include "clod/collision_body.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -55,7 +56,27 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree) : mesh_(std::mo
   diagonal_ = mesh_.bounds().diagonal();
 
   faceNormalOffsets_.assign(1, 0);
+  patchVertexOffsets_.assign(1, 0);
   std::vector<Vec3> distinct;
+  std::vector<std::uint32_t> vertices;
+  std::vector<Vec3> edgeDirections;
+  edgeDirectionOffsets_.assign(1, 0);
+  // Edge -> triangle table (sorted by edge), for the coplanar neighbours of patch triangles.
+  struct EdgeRef {
+    std::uint32_t v0, v1, triangle;
+  };
+  std::vector<EdgeRef> edges;
+  edges.reserve(3 * std::size_t{mesh_.triangleCount()});
+  for (std::uint32_t t = 0; t < mesh_.triangleCount(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t u = mesh_.triangles[t][k], w = mesh_.triangles[t][(k + 1) % 3];
+      edges.push_back({std::min(u, w), std::max(u, w), t});
+    }
+  }
+  std::sort(edges.begin(), edges.end(), [](const EdgeRef& x, const EdgeRef& y) {
+    if (x.v0 != y.v0) return x.v0 < y.v0;
+    return x.v1 != y.v1 ? x.v1 < y.v1 : x.triangle < y.triangle;
+  });
   for (std::uint32_t i = 0; i < tree_.sphereCount(); ++i) {
     distinct.clear();
     for (std::uint32_t t : tree_.triangles(i)) {
@@ -66,10 +87,53 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree) : mesh_(std::mo
       if (!known) distinct.push_back(n);
       if (distinct.size() > kMaxSphereFaceNormals) break;
     }
-    if (distinct.size() <= kMaxSphereFaceNormals) {
+    const bool faceted = !distinct.empty() && distinct.size() <= kMaxSphereFaceNormals;
+    if (faceted) {
       for (const Vec3& d : distinct) faceNormals_.push_back(d.cast<float>());
+      vertices.clear();
+      edgeDirections.clear();
+      for (std::uint32_t t : tree_.triangles(i)) {
+        for (int k = 0; k < 3; ++k) vertices.push_back(mesh_.triangles[t][k]);
+        // The coplanar neighbours' far corners too: a face split into triangles ends at a
+        // diagonal that is no edge of the body; a patch holding only one of the triangles would
+        // otherwise look like a sliver where that diagonal passes over the other body's edge.
+        const Vec3 n = mesh_.triangleNormal(t);
+        for (int k = 0; k < 3; ++k) {
+          const std::uint32_t u = mesh_.triangles[t][k], w = mesh_.triangles[t][(k + 1) % 3];
+          const auto range = std::equal_range(edges.begin(), edges.end(), EdgeRef{std::min(u, w), std::max(u, w), 0},
+                                              [](const EdgeRef& x, const EdgeRef& y) {
+                                                return x.v0 != y.v0 ? x.v0 < y.v0 : x.v1 < y.v1;
+                                              });
+          bool sharp = false;
+          for (auto it = range.first; it != range.second; ++it) {
+            if (it->triangle == t) continue;
+            if (mesh_.triangleNormal(it->triangle).dot(n) <= 1.0 - 5e-13) {
+              sharp = true;
+              continue;
+            }
+            for (int q = 0; q < 3; ++q) vertices.push_back(mesh_.triangles[it->triangle][q]);
+          }
+          if (sharp || range.second - range.first == 1) {
+            // A body edge (or a border): its direction is a separating-axis ingredient.
+            const Vec3 e = (mesh_.vertices[w] - mesh_.vertices[u]).normalized();
+            bool known = false;
+            for (const Vec3& d : edgeDirections) known = known || std::abs(d.dot(e)) > 1.0 - 5e-13;
+            if (!known && e.allFinite()) edgeDirections.push_back(e);
+          }
+        }
+      }
+      std::sort(vertices.begin(), vertices.end());
+      vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+      if (vertices.size() <= kMaxSpherePatchVertices) {
+        patchVertices_.insert(patchVertices_.end(), vertices.begin(), vertices.end());
+        if (edgeDirections.size() <= kMaxSphereEdgeDirections) {
+          for (const Vec3& d : edgeDirections) edgeDirections_.push_back(d.cast<float>());
+        }
+      }
     }
+    edgeDirectionOffsets_.push_back(static_cast<std::uint32_t>(edgeDirections_.size()));
     faceNormalOffsets_.push_back(static_cast<std::uint32_t>(faceNormals_.size()));
+    patchVertexOffsets_.push_back(static_cast<std::uint32_t>(patchVertices_.size()));
   }
 }
 

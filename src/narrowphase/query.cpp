@@ -126,7 +126,7 @@ struct QueryScratch::Impl {
   std::vector<std::array<std::uint32_t, 2>> volumePairs;
   std::vector<std::uint32_t> clippers;
   std::vector<Vec3> poly, polyTmp;
-  std::vector<Contact> raw;
+  std::vector<Contact> raw, apart;
   std::vector<ContactPoint> sampled;
   std::vector<double> manifold;
 };
@@ -326,13 +326,18 @@ DosContact dosContact(const Vec3& cA, double rA, const Vec3& cB, double rB) {
 // centre toward A's); A's outward normal should face B (n_A . u < 0), B's should face A.
 //  1. if they agree (n_B and -n_A within 10 deg), n = normalize(n_B - n_A): both surfaces'
 //     normals; for face-on-face n_A = -n_B so n = n_B, on smooth bodies their average;
-//  2. if exactly one of them faces the other sphere, it wins: the other sphere's lookup found
+//  2. if both spheres are faceted patches (CollisionBody::spherePatchVertices), the separating-
+//     axis choice of leastOverlapNormal below: the candidate (both patches' face normals and
+//     edge-edge cross products; map pseudonormals are no SAT axes and were measured to undercut
+//     the face normal where an edge of A lies along an edge of B) along which the patches overlap least, ignoring axes along which they are
+//     apart; where every axis separates them, the rules below;
+//  3. if exactly one of them faces the other sphere, it wins: the other sphere's lookup found
 //     a feature that turns away from the contact (a loose sphere whose nearest surface is a side
 //     face, not the one touching);
-//  3. if exactly one of them is a face normal of its sphere's triangles
+//  4. if exactly one of them is a face normal of its sphere's triangles
 //     (CollisionBody::sphereFaceNormals; an edge or vertex pseudonormal is not), it wins: an edge
 //     or corner meeting a face is pushed along the face normal;
-//  4. otherwise the one that faces the other sphere more (larger n_B . u or -n_A . u): of two
+//  5. otherwise the one that faces the other sphere more (larger n_B . u or -n_A . u): of two
 //     faces of a box meeting another box, the one turned toward the contact.
 // (A vanishing rule-1 normal, n_A = n_B, gives the D&O normal.)
 constexpr double kAgreeCos = 0.984807753012208;   // cos 10 deg
@@ -345,6 +350,72 @@ bool isFaceNormal(const Vec3& nLocal, std::span<const Vec3f> faces) {
   return false;
 }
 
+enum class PatchAxis : std::uint8_t { kNotFaceted, kChosen, kApart };
+
+// Support of a faceted sphere's patch in direction nLocal (body-local): max n . v over the
+// vertices of the triangles the sphere is responsible for. Whole triangles, not their part inside
+// the sphere: where a sphere cuts a face just at the other body's edge, the cut would look like a
+// real boundary and make the side face the least-overlap axis.
+double patchSupport(const CollisionBody& body, std::uint32_t sphere, const Vec3& nLocal) {
+  double support = -std::numeric_limits<double>::infinity();
+  for (std::uint32_t i : body.spherePatchVertices(sphere)) support = std::max(support, nLocal.dot(body.mesh().vertices[i]));
+  return support;
+}
+
+// Separating-axis choice for two faceted patches (both spheres have face normals and vertex
+// lists): among the face normals of both patches (B's, and A's negated, all as B -> A), the
+// cross products of their body-edge directions (edge-edge axes) -- the candidate axes of the
+// separating-axis test for convex polyhedra -- the direction along which the patches' projections overlap least,
+// overlap(n) = support_B(n) - (-support_A(-n)). This is the SAT's minimum-penetration axis
+// (Gottschalk et al. 1996 use the same test for OBBs): for a face resting on a face it is the
+// face normal, whatever the spheres' centre line; where an edge of A crosses an edge of B both
+// maps may return side faces, but along a side face the other patch overlaps by about its
+// sphere's radius, along the resting face only by the penetration. Axes with a negative overlap
+// are skipped: along them these two patches are apart, the sphere pair's overlap is the spheres'
+// looseness (a side face of A next to a side face of B), and pushing along such an axis would
+// slide the bodies sideways; the axis of least positive overlap is the one they are pressed
+// along. Returns false when a patch is not faceted (curved, or too many vertices) or every axis
+// separates: then the lookup rules decide.
+PatchAxis leastOverlapNormal(const CollisionBody& bodyA, std::uint32_t sa, const CollisionBody& bodyB,
+                             std::uint32_t sb, const Pose& xfAFromB, Vec3& best) {
+  if (bodyA.spherePatchVertices(sa).empty() || bodyB.spherePatchVertices(sb).empty()) return PatchAxis::kNotFaceted;
+  double bestOverlap = std::numeric_limits<double>::infinity();
+  bool apart = false;
+  auto consider = [&](const Vec3& n) {  // n in A's frame; both n and -n are tried
+    const Vec3 nInB = xfAFromB.rotation.conjugate() * n;
+    const double shift = n.dot(xfAFromB.translation);
+    const double maxB = patchSupport(bodyB, sb, nInB) + shift;
+    const double minB = -patchSupport(bodyB, sb, -nInB) + shift;
+    const double maxA = patchSupport(bodyA, sa, n);
+    const double minA = -patchSupport(bodyA, sa, -n);
+    const double alongN = maxB - minA;   // push A along +n by this much to separate
+    const double againstN = maxA - minB; // or along -n by this much
+    if (alongN < 0.0 || againstN < 0.0) {
+      apart = true;  // the projections do not overlap: a separating axis
+      return;
+    }
+    if (alongN < bestOverlap) {
+      bestOverlap = alongN;
+      best = n;
+    }
+    if (againstN < bestOverlap) {
+      bestOverlap = againstN;
+      best = -n;
+    }
+  };
+  for (const Vec3f& f : bodyB.sphereFaceNormals(sb)) consider(xfAFromB.rotation * f.cast<double>());
+  for (const Vec3f& f : bodyA.sphereFaceNormals(sa)) consider(f.cast<double>());
+  for (const Vec3f& ea : bodyA.sphereEdgeDirections(sa)) {
+    for (const Vec3f& eb : bodyB.sphereEdgeDirections(sb)) {
+      const Vec3 axis = ea.cast<double>().cross(xfAFromB.rotation * eb.cast<double>());
+      const double length = axis.norm();
+      if (length < 1e-6) continue;  // parallel edges: their axes are face normals already
+      consider(axis / length);
+    }
+  }
+  return apart ? PatchAxis::kApart : PatchAxis::kChosen;
+}
+
 Vec3 differenceNormal(const Vec3& nA, const Vec3& nB, const Vec3& dosNormal) {
   const Vec3 sum = nB - nA;
   const double len = sum.norm();
@@ -353,10 +424,13 @@ Vec3 differenceNormal(const Vec3& nA, const Vec3& nB, const Vec3& dosNormal) {
 }
 
 void sphereContacts(ContactModel model, const CollisionBody& bodyA, const CollisionBody& bodyB, const Pose& xfAFromB,
-                    const std::vector<SpherePair>& front, std::vector<Contact>& out) {
+                    const std::vector<SpherePair>& front, std::vector<Contact>& out, std::vector<Contact>& apart) {
   const SphereTree& ta = bodyA.sphereTree();
   const SphereTree& tb = bodyB.sphereTree();
+  const std::size_t first = out.size();
+  apart.clear();
   for (const SpherePair& p : front) {
+    bool proven = false;  // the pair's patches are proven apart
     const Vec3 cA = ta.center(p.a);
     const Vec3 cB = xfAFromB.apply(tb.center(p.b));
     const double rA = ta.radius[p.a];
@@ -385,7 +459,11 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
       // The face test only matters where the normals disagree (rule 2), and only for cfm: the
       // average model is the paper's straw man and stays plain.
       c.normal = differenceNormal(nA, nB, dos.normal);
-      if (model == ContactModel::kCfm && nB.dot(-nA) < kAgreeCos) {
+      const PatchAxis axis = model == ContactModel::kCfm && nB.dot(-nA) < kAgreeCos
+                                 ? leastOverlapNormal(bodyA, p.a, bodyB, p.b, xfAFromB, c.normal)
+                                 : PatchAxis::kChosen;
+      proven = axis == PatchAxis::kApart;
+      if (axis != PatchAxis::kChosen) {
         const bool facingA = nA.dot(dos.normal) < 0.0;
         const bool facingB = nB.dot(dos.normal) > 0.0;
         if (facingA != facingB) {
@@ -401,8 +479,12 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
         }
       }
     }
-    out.push_back(c);
+    (proven ? apart : out).push_back(c);
   }
+  // A pair whose faceted patches have a separating axis cannot touch: its sphere overlap is the
+  // spheres' looseness, and its lookup normals are side faces. Such pairs give contacts only
+  // when no other pair does (the query still reports the collision of its frontier).
+  if (out.size() == first) out.insert(out.end(), apart.begin(), apart.end());
 }
 
 Contact toWorld(const Contact& local, const Pose& xfWorldFromA) {
@@ -697,12 +779,12 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
         for (std::size_t i = 0; i < s.sphereFront.size(); ++i) {
           if (!s.pairDone[i]) s.sphereNext.push_back(s.sphereFront[i]);
         }
-        sphereContacts(ContactModel::kDos, a, b, xfAFromB, s.sphereNext, s.raw);
+        sphereContacts(ContactModel::kDos, a, b, xfAFromB, s.sphereNext, s.raw, s.apart);
         finished = false;
       }
       result.colliding = complete ? !s.raw.empty() : !s.sphereFront.empty();
     } else {
-      sphereContacts(model, a, b, xfAFromB, s.sphereFront, s.raw);
+      sphereContacts(model, a, b, xfAFromB, s.sphereFront, s.raw, s.apart);
       result.colliding = !s.sphereFront.empty();
     }
     if (c != nullptr) {

@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <iostream>
+#include <cstdio>
 #include <random>
 #include <string>
 #include <vector>
@@ -90,13 +90,10 @@ double meanAngleToUp(const QueryResult& r) {
 }
 
 TEST(NarrowPhaseCubeOnCube, CfmGivesTheFaceNormalWithinTwoDegreesAtEveryBudget) {
-  // Per contact, the face normal within 2 degrees for all but the contacts of sphere pairs at
-  // the boxes' edges, where both spheres' maps can return a side face (docs/narrow-phase.md,
-  // "known limits"). Measured: 221 of 228 contacts within 2 degrees, worst depth-weighted
-  // resultant 3.6 degrees. Asserted: at least 90 % of the contacts, and the resultant within 5.
+  // Every contact of every budget, as the issue asks. 2 degrees: the map's 16-bit normal codec
+  // is good to ~0.95 degrees, the face normals of the box are exact.
   const Bodies& b = bodies();
-  int contacts = 0, within = 0;
-  double worstResultant = 0.0;
+  int contacts = 0;
   for (const Vec3& offset : restingOffsets()) {
     const Pose poseA = restingPose(offset.x(), offset.y(), kRestingPenetration);
     for (std::uint64_t budget : budgets()) {
@@ -104,17 +101,56 @@ TEST(NarrowPhaseCubeOnCube, CfmGivesTheFaceNormalWithinTwoDegreesAtEveryBudget) 
       ASSERT_TRUE(r.colliding);
       ASSERT_FALSE(r.contacts.empty());
       EXPECT_LE(r.contacts.size(), 8u);
-      worstResultant = std::max(worstResultant, angleBetween(resultantNormal(r), Vec3::UnitZ()));
       for (const Contact& c : r.contacts) {
         ++contacts;
-        within += angleBetween(c.normal, Vec3::UnitZ()) < 2.0 * kDegree ? 1 : 0;
+        EXPECT_LT(angleBetween(c.normal, Vec3::UnitZ()), 2.0 * kDegree)
+            << "offset " << offset.transpose() << " budget " << budget << " level " << c.level << " normal "
+            << c.normal.transpose() << " at " << c.point.transpose();
       }
     }
   }
-  std::cout << "cfm cube-on-cube: " << within << " of " << contacts << " contacts within 2 degrees; worst resultant "
-            << worstResultant / kDegree << " degrees\n";
-  EXPECT_GE(within, contacts * 9 / 10);
-  EXPECT_LT(worstResultant, 5.0 * kDegree);
+  EXPECT_GT(contacts, 100);  // the poses and budgets produce many contacts (228 when written)
+}
+
+TEST(NarrowPhaseCubeOnCube, CfmGivesTheFaceNormalForAlmostAllContactsOfTurnedCubes) {
+  // Beyond the issue's case: cube A resting on a face of B, turned about the normal by a random
+  // angle (its edges cross B's at random angles) and offset by up to a quarter width, the pair
+  // rolled onto another face so the normal is not +z. Here a patch pair's own least-overlap
+  // axis can be a side face where a corner of A pokes a few thousandths past B's side plane (or
+  // a corner of B past A's): the local patches cannot see the rest of the bodies. Measured with
+  // 200 poses x 5 budgets: 7,904 of 7,915 contacts within 2 degrees (11 off, 0.14 %).
+  // Asserted: 99.5 % of the contacts within 2 degrees.
+  const Bodies& b = bodies();
+  std::mt19937_64 rng(23);
+  // Turns between 10 and 80 degrees (mod 90): edges of A and B at least 10 degrees from
+  // parallel. Nearly parallel side faces a few thousandths apart are the near-degenerate version
+  // of the flush case (docs/narrow-phase.md, known limits).
+  std::uniform_real_distribution<double> angle(10.0 * kDegree, 80.0 * kDegree), offset(-0.5, 0.5);
+  std::uniform_int_distribution<int> quarter(0, 3);
+  const int poses = test::sanitizerRun() ? 10 : 200;
+  const Quat roll(Eigen::AngleAxisd(0.5 * kPi, Vec3::UnitX()));  // B's +z face turned to -y
+  const Vec3 up = roll * Vec3::UnitZ();
+  int contacts = 0, within = 0;
+  QueryScratch scratch;
+  QueryResult r;
+  for (int i = 0; i < poses; ++i) {
+    Pose poseA;
+    poseA.rotation = roll * Quat(Eigen::AngleAxisd(angle(rng) + 0.5 * kPi * quarter(rng), Vec3::UnitZ()));
+    poseA.translation = roll * Vec3(offset(rng), offset(rng), 2.0 - kRestingPenetration);
+    Pose poseB;
+    poseB.rotation = roll;
+    for (std::uint64_t budget : budgets()) {
+      queryContacts(b.cubeA, poseA, b.cubeB, poseB, settingsFor(ContactModel::kCfm, budget), scratch, r);
+      ASSERT_TRUE(r.colliding);
+      ASSERT_FALSE(r.contacts.empty());
+      for (const Contact& c : r.contacts) {
+        ++contacts;
+        within += angleBetween(c.normal, up) < 2.0 * kDegree ? 1 : 0;
+      }
+    }
+  }
+  std::printf("cfm turned cube on cube: %d of %d contacts within 2 degrees\n", within, contacts);
+  EXPECT_GE(static_cast<double>(within), 0.995 * contacts);
 }
 
 TEST(NarrowPhaseCubeOnCube, ContactTreeAndExactGiveTheFaceNormalAtFullBudget) {
