@@ -49,4 +49,4 @@ echo "test-viewer: serving at $url"
 
 shot="${CLOD_VIEWER_SCREENSHOT:-${TMPDIR:-/tmp}/clod-viewer-e2e.png}"
 cd "$repo/viewer"
-timeout 180 node e2e/viewer.e2e.mjs --url "$url" --out "$tmp/out" --screenshot "$shot"
+timeout 180 node e2e/viewer.e2e.mjs --url "$url" --out "$tmp/out" --screenshot "$shot" --page-file dist/index.html

@@ -6,9 +6,12 @@
 //     the last frame matches summary.json's final positions (when the last frame is the end);
 //   - the contact layer is empty when off and shows exactly layers.json's contacts of a frame when on;
 //   - the sphere-tree, CFM and contact-tree layers show as many items as layers.json holds;
-//   - a screenshot has pixels drawn where the bodies project and background elsewhere.
+//   - a screenshot has pixels drawn where the bodies project and background elsewhere;
+//   - with --page-file: the built page opened from file:// offers the picker and loads the
+//     folder's files chosen there.
 //
 //   node e2e/viewer.e2e.mjs --url http://127.0.0.1:PORT/ --out OUTDIR [--screenshot FILE.png]
+//                           [--page-file viewer/dist/index.html]
 // Exits 0 when every check passes, 1 otherwise (each failure is printed).
 import fs from 'node:fs';
 import path from 'node:path';
@@ -22,6 +25,7 @@ const arg = (name, fallback) => {
 const url = arg('--url');
 const outDir = arg('--out');
 const screenshotPath = arg('--screenshot', path.join(outDir ?? '.', 'viewer-e2e.png'));
+const pageFile = arg('--page-file');
 const chromiumPath = process.env.CHROMIUM_PATH || '/usr/bin/chromium';
 if (!url || !outDir) {
   console.error('usage: node e2e/viewer.e2e.mjs --url URL --out OUTDIR [--screenshot FILE.png]');
@@ -166,6 +170,24 @@ try {
     `screenshot shows both background and scene (background ${(100 * pixelCheck.backgroundShare).toFixed(1)} %)`);
   check(pageErrors.length === 0, `no errors in the page${pageErrors.length ? ': ' + pageErrors.join(' | ') : ''}`);
   console.log(`screenshot: ${screenshotPath}`);
+
+  if (pageFile) {
+    // Offline mode: file:// cannot fetch neighbours, so the page must offer the picker.
+    const offline = await browser.newPage({ viewport: { width: 1024, height: 640 } });
+    const offlineErrors = [];
+    offline.on('pageerror', (e) => offlineErrors.push(String(e)));
+    await offline.goto(`file://${path.resolve(pageFile)}`, { waitUntil: 'load', timeout: 30_000 });
+    await offline.waitForFunction(() => window.__clod !== undefined, null, { timeout: 15_000 });
+    check(await offline.isVisible('#picker'), 'the page opened from file:// shows the folder picker');
+    const files = ['scene.glb', 'layers.json', 'summary.json'].map((f) => path.join(outDir, f)).filter((f) => fs.existsSync(f));
+    await offline.setInputFiles('#files-input', files);
+    const offlineLoad = await offline.evaluate(() =>
+      Promise.race([window.__clod.ready.then(() => null, (e) => String(e)), new Promise((r) => setTimeout(() => r('timeout'), 30_000))]));
+    const offlineBodies = await offline.evaluate(() => window.__clod.bodyCount);
+    check(offlineLoad === null && offlineBodies === expectedNames.length,
+      `from file://, picking the folder's files loads ${offlineBodies} bodies (${offlineLoad ?? 'ready'})`);
+    check(offlineErrors.length === 0, `no errors in the file:// page${offlineErrors.length ? ': ' + offlineErrors.join(' | ') : ''}`);
+  }
 } catch (e) {
   failures.push(String(e));
   console.error(`viewer e2e: ${e}`);

@@ -1,0 +1,277 @@
+// `clod view`: the static HTTP server behind the web viewer. Starts the built CLI on port 0 with
+// a stand-in viewer folder and output folder, talks raw HTTP/1.1 to it over a socket, and
+// checks the answers against the files on disk (the oracle): bytes, Content-Type, status codes,
+// refusal of every path that would leave the served folders, and a clean stop on SIGTERM.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "cli/cli_runner.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using clod::test::quoted;
+using clod::test::runCli;
+
+struct HttpReply {
+  int status = 0;
+  std::string head;
+  std::string body;
+  std::string header(const std::string& name) const {
+    const std::regex re("\r\n" + name + ": ([^\r]*)\r\n", std::regex::icase);
+    std::smatch m;
+    return std::regex_search(head, m, re) ? m[1].str() : std::string();
+  }
+};
+
+// Sends one raw request and reads until the server closes the connection.
+HttpReply request(int port, const std::string& raw) {
+  HttpReply reply;
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(std::uint16_t(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    ::close(fd);
+    return reply;
+  }
+  timeval timeout{20, 0};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
+  ::send(fd, raw.data(), raw.size(), MSG_NOSIGNAL);
+  std::string all;
+  char buffer[8192];
+  ssize_t n;
+  while ((n = ::recv(fd, buffer, sizeof buffer, 0)) > 0) all.append(buffer, std::size_t(n));
+  ::close(fd);
+  const std::size_t split = all.find("\r\n\r\n");
+  if (split == std::string::npos) return reply;
+  reply.head = all.substr(0, split + 2);
+  reply.body = all.substr(split + 4);
+  if (reply.head.rfind("HTTP/1.1 ", 0) == 0) reply.status = std::atoi(reply.head.c_str() + 9);
+  return reply;
+}
+
+HttpReply get(int port, const std::string& target, const std::string& method = "GET") {
+  return request(port, method + " " + target + " HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n");
+}
+
+std::string readFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void writeFile(const fs::path& path, const std::string& content) {
+  fs::create_directories(path.parent_path());
+  std::ofstream(path, std::ios::binary) << content;
+}
+
+// A running `clod view` child process; its first stdout line carries the URL.
+struct Server {
+  pid_t pid = -1;
+  int port = 0;
+  std::string firstLine;
+};
+
+Server startServer(const std::vector<std::string>& args) {
+  Server server;
+  int out[2];
+  if (::pipe(out) != 0) return server;
+  server.pid = ::fork();
+  if (server.pid == 0) {
+    ::dup2(out[1], STDOUT_FILENO);
+    ::close(out[0]);
+    ::close(out[1]);
+    std::vector<char*> argv{const_cast<char*>(CLOD_CLI_PATH), const_cast<char*>("view")};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::execv(CLOD_CLI_PATH, argv.data());
+    ::_exit(127);
+  }
+  ::close(out[1]);
+  // Wait for the URL line (generous: the sanitizer build starts slowly).
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  std::string text;
+  while (text.find('\n') == std::string::npos && std::chrono::steady_clock::now() < deadline) {
+    pollfd p{out[0], POLLIN, 0};
+    if (::poll(&p, 1, 200) <= 0) continue;
+    char c[256];
+    const ssize_t n = ::read(out[0], c, sizeof c);
+    if (n <= 0) break;
+    text.append(c, std::size_t(n));
+  }
+  ::close(out[0]);  // the server's later lines go nowhere; it ignores SIGPIPE
+  server.firstLine = text.substr(0, text.find('\n'));
+  std::smatch m;
+  const std::regex url(R"(http://127\.0\.0\.1:(\d+)/)");
+  if (std::regex_search(server.firstLine, m, url)) server.port = std::stoi(m[1].str());
+  return server;
+}
+
+// Stops the server with `signal` and returns its exit code (-1 if it did not stop in time).
+int stopServer(Server& server, int signal = SIGTERM) {
+  if (server.pid <= 0) return -1;
+  ::kill(server.pid, signal);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  int status = 0;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (::waitpid(server.pid, &status, WNOHANG) == server.pid) {
+      server.pid = -1;
+      return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ::kill(server.pid, SIGKILL);
+  ::waitpid(server.pid, &status, 0);
+  server.pid = -1;
+  return -1;
+}
+
+class ClodView : public ::testing::Test {
+protected:
+  static void SetUpTestSuite() {
+    root_ = fs::temp_directory_path() / ("clod_view_test_" + std::to_string(::getpid()));
+    fs::remove_all(root_);
+    writeFile(root_ / "viewer" / "index.html", "<!doctype html><title>stand-in viewer</title>\n");
+    writeFile(root_ / "viewer" / "assets" / "app.js", "console.log('stand-in');\n");
+    std::string glb("glTF\x02\0\0\0", 8);
+    for (int i = 0; i < 70000; ++i) glb += char(i * 7 % 256);  // binary, with NULs, > one socket buffer
+    writeFile(root_ / "out" / "scene.glb", glb);
+    writeFile(root_ / "out" / "layers.json", R"({"format":"clod-layers","version":1})");
+    writeFile(root_ / "out" / "trajectory.csv", "step,time\n0,0\n");
+    writeFile(root_ / "out" / "my plot.svg", "<svg xmlns='http://www.w3.org/2000/svg'/>");
+    writeFile(root_ / kSecretName, kSecret);
+    fs::create_directory_symlink(root_, root_ / "out" / "escape");  // a link leaving the root
+    server_ = startServer({(root_ / "out").string(), "--port", "0", "--viewer-dir", (root_ / "viewer").string(),
+                           "--quit-after", "600"});
+  }
+  static void TearDownTestSuite() {
+    stopServer(server_);
+    fs::remove_all(root_);
+  }
+
+  static inline fs::path root_;
+  static inline Server server_;
+  static constexpr const char* kSecretName = "secret.txt";
+  static constexpr const char* kSecret = "do-not-serve-7f3a9c";
+};
+
+TEST_F(ClodView, PrintsTheUrlWithTheChosenFreePort) {
+  EXPECT_GT(server_.port, 0) << "first line: " << server_.firstLine;
+}
+
+TEST_F(ClodView, ServesTheViewerIndexAtTheRoot) {
+  const HttpReply r = get(server_.port, "/");
+  EXPECT_EQ(r.status, 200);
+  EXPECT_EQ(r.header("Content-Type"), "text/html; charset=utf-8");
+  EXPECT_EQ(r.body, readFile(root_ / "viewer" / "index.html"));
+  const HttpReply js = get(server_.port, "/assets/app.js?v=1");
+  EXPECT_EQ(js.status, 200);
+  EXPECT_EQ(js.header("Content-Type"), "text/javascript; charset=utf-8");
+  EXPECT_EQ(js.body, readFile(root_ / "viewer" / "assets" / "app.js"));
+}
+
+TEST_F(ClodView, ServesTheOutputFolderUnderDataByteForByte) {
+  const HttpReply glb = get(server_.port, "/data/scene.glb");
+  EXPECT_EQ(glb.status, 200);
+  EXPECT_EQ(glb.header("Content-Type"), "model/gltf-binary");
+  EXPECT_EQ(glb.header("Content-Length"), std::to_string(fs::file_size(root_ / "out" / "scene.glb")));
+  EXPECT_TRUE(glb.body == readFile(root_ / "out" / "scene.glb"));
+  const HttpReply json = get(server_.port, "/data/layers.json");
+  EXPECT_EQ(json.status, 200);
+  EXPECT_EQ(json.header("Content-Type"), "application/json");
+  EXPECT_EQ(json.body, readFile(root_ / "out" / "layers.json"));
+  EXPECT_EQ(get(server_.port, "/data/trajectory.csv").header("Content-Type"), "text/csv; charset=utf-8");
+  const HttpReply svg = get(server_.port, "/data/my%20plot.svg");  // percent-decoded name
+  EXPECT_EQ(svg.status, 200);
+  EXPECT_EQ(svg.header("Content-Type"), "image/svg+xml");
+}
+
+TEST_F(ClodView, AnswersHeadWithTheHeadersOfGetAndNoBody) {
+  const HttpReply r = get(server_.port, "/data/scene.glb", "HEAD");
+  EXPECT_EQ(r.status, 200);
+  EXPECT_EQ(r.header("Content-Length"), std::to_string(fs::file_size(root_ / "out" / "scene.glb")));
+  EXPECT_EQ(r.header("Content-Type"), "model/gltf-binary");
+  EXPECT_TRUE(r.body.empty()) << r.body.size() << " body bytes";
+}
+
+TEST_F(ClodView, AnswersMissingFilesWith404) {
+  EXPECT_EQ(get(server_.port, "/data/nothing.json").status, 404);
+  EXPECT_EQ(get(server_.port, "/nothing.js").status, 404);
+  EXPECT_EQ(get(server_.port, "/data/").status, 404);  // no directory listings
+}
+
+TEST_F(ClodView, RefusesEveryPathThatLeavesTheServedFolders) {
+  for (const std::string target :
+       {"/data/../secret.txt", "/../secret.txt", "/data/%2e%2e/secret.txt", "/data/..%2fsecret.txt",
+        "/data/%2E%2E%2Fsecret.txt", "/data/..\\secret.txt", "/data//../secret.txt", "/data/escape/secret.txt",
+        "/data/./../secret.txt", "secret.txt", "/data/%00/../secret.txt"}) {
+    const HttpReply r = get(server_.port, target);
+    EXPECT_GE(r.status, 400) << target;
+    EXPECT_LT(r.status, 500) << target;
+    EXPECT_EQ(r.body.find(kSecret), std::string::npos) << target;
+  }
+}
+
+TEST_F(ClodView, AnswersOtherMethodsWith405AndMalformedRequestsWith400) {
+  const HttpReply post = get(server_.port, "/data/scene.glb", "POST");
+  EXPECT_EQ(post.status, 405);
+  EXPECT_EQ(post.header("Allow"), "GET, HEAD");
+  EXPECT_EQ(request(server_.port, "garbage\r\n\r\n").status, 400);
+  EXPECT_EQ(get(server_.port, "/data/%zz").status, 400);
+}
+
+TEST_F(ClodView, StopsCleanlyOnSigint) {
+  Server own = startServer({(root_ / "out").string(), "--port", "0", "--viewer-dir", (root_ / "viewer").string(),
+                            "--quit-after", "120"});
+  ASSERT_GT(own.port, 0) << own.firstLine;
+  EXPECT_EQ(get(own.port, "/").status, 200);
+  EXPECT_EQ(stopServer(own, SIGINT), 0);
+}
+
+TEST_F(ClodView, FailsWithExitCode1WhenTheOutputFolderOrSceneIsMissing) {
+  const std::string viewer = " --viewer-dir " + quoted(root_ / "viewer") + " --port 0 --quit-after 5";
+  const auto noFolder = runCli("view " + quoted(root_ / "no-such-folder") + viewer);
+  EXPECT_EQ(noFolder.exitCode, 1);
+  EXPECT_NE(noFolder.err.find("no-such-folder"), std::string::npos) << noFolder.err;
+  const auto noScene = runCli("view " + quoted(root_ / "viewer") + viewer);  // a folder without scene.glb
+  EXPECT_EQ(noScene.exitCode, 1);
+  EXPECT_NE(noScene.err.find("scene.glb"), std::string::npos) << noScene.err;
+}
+
+TEST_F(ClodView, FailsWithExitCode1WhenTheViewerIsNotBuilt) {
+  const auto r = runCli("view " + quoted(root_ / "out") + " --viewer-dir " + quoted(root_ / "out") +
+                        " --port 0 --quit-after 5");
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_NE(r.err.find("viewer not built: run scripts/build-viewer.sh"), std::string::npos) << r.err;
+  ::setenv("CLOD_VIEWER_DIR", (root_ / "no-viewer-here").c_str(), 1);
+  const auto fromEnv = runCli("view " + quoted(root_ / "out") + " --port 0 --quit-after 5");
+  ::unsetenv("CLOD_VIEWER_DIR");
+  EXPECT_EQ(fromEnv.exitCode, 1);
+  EXPECT_NE(fromEnv.err.find("no-viewer-here"), std::string::npos) << fromEnv.err;
+}
+
+TEST_F(ClodView, FailsWithExitCode2OnAnOutOfRangePort) {
+  const auto r = runCli("view " + quoted(root_ / "out") + " --viewer-dir " + quoted(root_ / "viewer") +
+                        " --port 70000 --quit-after 5");
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_NE(r.err.find("--port"), std::string::npos) << r.err;
+}
+
+}  // namespace
