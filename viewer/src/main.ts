@@ -282,7 +282,7 @@ async function start(): Promise<void> {
   let base = param ?? './data/';
   if (!base.endsWith('/')) base += '/';
   try {
-    await show(await fetchFolder(new URL(base, location.href).href));
+    await show({ ...(await fetchFolder(new URL(base, location.href).href)), label: base.replace(/^\.\//, '') });
     resolveReady();
   } catch (e) {
     hook.error = (e as Error).message;
