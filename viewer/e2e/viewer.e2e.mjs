@@ -48,6 +48,17 @@ const summary = JSON.parse(fs.readFileSync(path.join(outDir, 'summary.json'), 'u
 const layersPath = path.join(outDir, 'layers.json');
 const layers = fs.existsSync(layersPath) ? JSON.parse(fs.readFileSync(layersPath, 'utf8')) : null;
 
+// The glTF's own JSON chunk (header 12 bytes, then chunk length, type "JSON", data): which
+// nodes are bodies, which are static, and the animation's channels.
+function readGlbJson(file) {
+  const b = fs.readFileSync(file);
+  if (b.readUInt32LE(0) !== 0x46546c67 || b.readUInt32LE(16) !== 0x4e4f534a) throw new Error(`${file}: not a binary glTF`);
+  return JSON.parse(b.subarray(20, 20 + b.readUInt32LE(12)).toString('utf8'));
+}
+const gltf = readGlbJson(path.join(outDir, 'scene.glb'));
+const bodyNodes = (gltf.nodes ?? []).filter((n) => typeof n.extras?.body === 'number').sort((a, b) => a.extras.body - b.extras.body);
+const staticByBody = bodyNodes.map((n) => n.extras.static === true);
+
 const browser = await chromium.launch({
   executablePath: chromiumPath,
   headless: true,
@@ -82,8 +93,17 @@ try {
   const dist = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
   const moved = p0.map((p, i) => Math.max(dist(p, p1[i]), dist(p, pL[i])));
   check(moved.some((d) => d > 1e-3), `stepping the animation moves a body (max ${Math.max(...moved).toExponential(2)} m)`);
-  const hasStaticFlag = summary.bodies.every((b) => typeof b.static === 'boolean');
-  if (hasStaticFlag) summary.bodies.forEach((b, i) => b.static && check(moved[i] === 0, `static body '${b.name}' stays put`));
+  check(bodyNodes.length === expectedNames.length, `scene.glb has ${bodyNodes.length} body nodes (extras.body)`);
+  staticByBody.forEach((isStatic, i) => isStatic && check(moved[i] === 0, `static body '${expectedNames[i]}' stays put`));
+  staticByBody.forEach((isStatic, i) => !isStatic && check(moved[i] > 0, `dynamic body '${expectedNames[i]}' moves`));
+
+  // Play: the frame advances on its own.
+  const startFrame = await page.evaluate(() => (window.__clod.setFrame(0), window.__clod.frame()));
+  await page.click('#play');
+  await page.waitForTimeout(800);
+  const playedTo = await page.evaluate(() => window.__clod.frame());
+  await page.click('#play');
+  check(playedTo > startFrame, `the play button advances the animation (frame ${startFrame} -> ${playedTo})`);
   // The last frame is the final state when frames run to steps*dt; compare with summary.json.
   const endTime = summary.steps * summary.dt;
   const lastTime = layers?.frames?.time?.[last];
