@@ -214,7 +214,8 @@ function setUpControls(folder: OutputFolder): void {
   const hasChart = chart.setData(folder.layers);
   ($('chart') as HTMLCanvasElement).hidden = !hasChart;
   view.resize();
-  $('info').textContent = `${folder.label} · ${bodies.length} bodies · ${view.frameCount} frames` +
+  const plural = (n: number, one: string, many: string) => `${n} ${n === 1 ? one : many}`;
+  $('info').textContent = `${folder.label} · ${plural(bodies.length, 'body', 'bodies')} · ${plural(view.frameCount, 'frame', 'frames')}` +
     (view.frameCount > 1 ? ` · ${view.duration.toFixed(2)} s` : '');
 }
 
