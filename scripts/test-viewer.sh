@@ -2,13 +2,13 @@
 # Browser test of the web viewer (docs/viewer.md): builds the viewer, runs the bunny-on-box demo
 # with glTF export, serves it with `clod view --port 0`, and drives the page in Debian's headless
 # Chromium (viewer/e2e/viewer.e2e.mjs). Exits non-zero on any failure; the server is always stopped.
-#   scripts/test-viewer.sh [PATH/TO/clod]      (default: $CLOD_BIN, else build/apps/clod/clod)
+#   scripts/test-viewer.sh [PATH/TO/clod]      (default: $CLOD_BIN, else build/bin/clod)
 # Environment: CLOD_VIEWER_SCREENSHOT=FILE.png keeps the screenshot there (default: in $TMPDIR);
 #              CLOD_VIEWER_FIXTURE=1 uses viewer/e2e/make-fixture.mjs instead of `clod simulate`;
 #              CHROMIUM_PATH overrides /usr/bin/chromium.
 set -euo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-clod="${1:-${CLOD_BIN:-$repo/build/apps/clod/clod}}"
+clod="${1:-${CLOD_BIN:-$repo/build/bin/clod}}"
 [[ -x "$clod" ]] || { echo "test-viewer: no clod binary at '$clod' (build target clod_cli, or pass its path)" >&2; exit 2; }
 clod="$(cd "$(dirname "$clod")" && pwd)/$(basename "$clod")"
 command -v node >/dev/null || { echo "test-viewer: node not found" >&2; exit 1; }
