@@ -3,6 +3,7 @@
 #include "clod/query.h"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <limits>
 #include <span>
@@ -72,12 +73,14 @@ struct SphereSide {
   Node root() const { return 0; }
   Vec3 center(Node n) const { return {tree.centerX[n], tree.centerY[n], tree.centerZ[n]}; }
   double radius(Node n) const { return tree.radius[n]; }
-  bool isLeaf(Node n) const { return tree.childCount[n] == 0; }
+  bool isLeaf(Node n) const { return tree.childCount[n] == 0 || body.sphereLevel(n) >= maxLevel; }
   std::uint32_t childCount(Node n) const { return tree.childCount[n]; }
   Node child(Node n, std::uint32_t k) const { return tree.firstChild[n] + k; }
   bool usable(Node) const { return true; }
   std::uint32_t level(Node n) const { return body.sphereLevel(n); }
   static std::uint32_t index(Node n) { return n; }
+  std::uint64_t triangleCount(Node n) const { return tree.triangleOffsets[n + 1] - tree.triangleOffsets[n]; }
+  std::uint32_t maxLevel = UINT32_MAX;  // QuerySettings::maxLevel
 };
 
 struct CellSide {
@@ -86,7 +89,7 @@ struct CellSide {
   Node root() const { return tree.rootCell(); }
   Vec3 center(const Node& c) const { return tree.cellCenter(c); }
   double radius(const Node& c) const { return tree.cellRadius(c.depth); }
-  bool isLeaf(const Node& c) const { return tree.isLeaf(c.node); }
+  bool isLeaf(const Node& c) const { return tree.isLeaf(c.node) || c.depth >= maxLevel; }
   std::uint32_t childCount(const Node&) const { return 8; }
   Node child(const Node& c, std::uint32_t k) const { return tree.childCell(c, k); }
   // A cell the field proves to be wholly outside its body holds neither surface nor interior:
@@ -94,6 +97,9 @@ struct CellSide {
   bool usable(const Node& c) const { return tree.minDistance(c) <= 0.0; }
   std::uint32_t level(const Node& c) const { return c.depth; }
   static std::uint32_t index(const Node& c) { return c.node; }
+  // Cells have no triangle lists: never final before the leaves.
+  static std::uint64_t triangleCount(const Node&) { return std::numeric_limits<std::uint32_t>::max(); }
+  std::uint32_t maxLevel = UINT32_MAX;  // QuerySettings::maxLevel
 };
 
 template <class NA, class NB>
@@ -123,6 +129,7 @@ struct QueryScratch::Impl {
   };
   std::vector<KeyedContact> exactContacts;
   std::vector<std::uint8_t> pairDone;
+  std::vector<std::uint64_t> pairSet;  // open-addressing set of triangle-pair keys
   std::vector<std::array<std::uint32_t, 2>> volumePairs;
   std::vector<std::uint32_t> clippers;
   std::vector<Vec3> poly, polyTmp;
@@ -164,6 +171,13 @@ std::size_t CoherenceCache::frontSize() const noexcept {
 
 namespace {
 
+// Exact model: a sphere pair whose triangle lists make at most this many triangle pairs is not
+// descended further; its triangle pairs are tested directly. Below that, descending costs up to
+// 8 sphere tests per level and finds the same large triangles again in many small spheres (a
+// box's 12 triangles fill every sphere of a 4-level tree), while a triangle test costs only a few
+// sphere tests and the pairs are deduplicated (docs/benchmarks/narrowphase.md, before/after).
+constexpr std::uint64_t kExactDirectPairs = 16;
+
 // ---------------------------------------------------------------------------------------------
 // The traversal. All geometry is in A's frame: B's centres are moved once per test.
 
@@ -176,8 +190,10 @@ public:
   using NB = typename SideB::Node;
   using Pair = NodePair<NA, NB>;
 
-  Traversal(const SideA& a, const SideB& b, const Pose& xfAFromB, Meter& meter)
-      : a_(a), b_(b), xfAFromB_(xfAFromB), meter_(meter) {}
+  // directPairs > 0: a pair whose triangle lists give at most that many triangle pairs is final
+  // (the exact model tests its triangles instead of descending further).
+  Traversal(const SideA& a, const SideB& b, const Pose& xfAFromB, Meter& meter, std::uint64_t directPairs)
+      : a_(a), b_(b), xfAFromB_(xfAFromB), meter_(meter), directPairs_(directPairs) {}
 
   TestOutcome test(const Vec3& centerA, double radiusA, const Vec3& centerBinA, double radiusB, double& penetration) {
     if (!meter_.take()) return TestOutcome::kOutOfBudget;
@@ -225,7 +241,7 @@ public:
         const Pair& p = front[i];
         const bool leafA = a_.isLeaf(p.a);
         const bool leafB = b_.isLeaf(p.b);
-        if (leafA && leafB) {
+        if ((leafA && leafB) || a_.triangleCount(p.a) * b_.triangleCount(p.b) <= directPairs_) {
           next.push_back(p);
           continue;
         }
@@ -290,6 +306,7 @@ private:
   const SideB& b_;
   Pose xfAFromB_;
   Meter& meter_;
+  std::uint64_t directPairs_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -601,23 +618,29 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
   bool complete = traversalFinished;
   if (traversalFinished) {
     // A triangle can belong to several leaves: test each triangle pair once, on behalf of the
-    // highest-priority frontier pair that holds it (front is sorted by priority).
+    // highest-priority frontier pair that holds it (front is sorted by priority). Pairs are
+    // generated in frontier order and deduplicated with an open-addressing set of (ta, tb) keys:
+    // the first occurrence is the highest-priority one, and no sort is needed (sorting the
+    // candidate list was ~40 % of a deep bunny query, perf).
+    std::uint64_t candidates = 0;
+    for (const SpherePair& p : front) candidates += std::uint64_t{ta.triangles(p.a).size()} * tb.triangles(p.b).size();
+    std::size_t capacity = 64;
+    while (capacity < 2 * candidates) capacity *= 2;
+    s.pairSet.assign(capacity, 0);
+    const std::size_t mask = capacity - 1;
+    const int shift = 64 - std::countr_zero(capacity);
     for (std::uint32_t i = 0; i < front.size(); ++i) {
       for (std::uint32_t triA : ta.triangles(front[i].a)) {
-        for (std::uint32_t triB : tb.triangles(front[i].b)) s.trianglePairs.push_back({triA, triB, i});
+        for (std::uint32_t triB : tb.triangles(front[i].b)) {
+          const std::uint64_t key = ((std::uint64_t{triA} + 1) << 32) | triB;  // never 0 (empty)
+          std::size_t slot = static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> shift);
+          while (s.pairSet[slot] != 0 && s.pairSet[slot] != key) slot = (slot + 1) & mask;
+          if (s.pairSet[slot] == key) continue;
+          s.pairSet[slot] = key;
+          s.trianglePairs.push_back({triA, triB, i});
+        }
       }
     }
-    using Ref = QueryScratch::Impl::TrianglePairRef;
-    std::sort(s.trianglePairs.begin(), s.trianglePairs.end(), [](const Ref& x, const Ref& y) {
-      if (x.ta != y.ta) return x.ta < y.ta;
-      if (x.tb != y.tb) return x.tb < y.tb;
-      return x.pair < y.pair;
-    });
-    s.trianglePairs.erase(std::unique(s.trianglePairs.begin(), s.trianglePairs.end(),
-                                      [](const Ref& x, const Ref& y) { return x.ta == y.ta && x.tb == y.tb; }),
-                          s.trianglePairs.end());
-    std::stable_sort(s.trianglePairs.begin(), s.trianglePairs.end(),
-                     [](const Ref& x, const Ref& y) { return x.pair < y.pair; });
 
     // Plane-distance tolerance: rounding of coordinates of the size of the two bodies.
     const double eps = 1e-12 * (bodyA.diagonal() + bodyB.diagonal() + xfAFromB.translation.norm());
@@ -715,8 +738,8 @@ void fillFrontier(const std::vector<Pair>& front, const SideA& sa, const SideB& 
 template <class SideA, class SideB, class Pair>
 bool traverse(const SideA& sa, const SideB& sb, const Pose& xfAFromB, Meter& meter, std::vector<Pair>& front,
               std::vector<Pair>& next, std::vector<Pair>& separated, bool track, std::vector<Pair>* cachedOverlap,
-              std::vector<Pair>* cachedSeparated) {
-  Traversal<SideA, SideB> t(sa, sb, xfAFromB, meter);
+              std::vector<Pair>* cachedSeparated, std::uint64_t directPairs) {
+  Traversal<SideA, SideB> t(sa, sb, xfAFromB, meter, directPairs);
   front.clear();
   separated.clear();
   std::vector<Pair>* sep = track ? &separated : nullptr;
@@ -764,10 +787,12 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
   bool finished = false;
 
   if (!cells) {
-    const SphereSide sa{a.sphereTree(), a};
-    const SphereSide sb{b.sphereTree(), b};
+    const std::uint32_t cap = model == ContactModel::kExact ? UINT32_MAX : settings.maxLevel;
+    const SphereSide sa{a.sphereTree(), a, cap};
+    const SphereSide sb{b.sphereTree(), b, cap};
     finished = traverse(sa, sb, xfAFromB, meter, s.sphereFront, s.sphereNext, s.sphereSeparated, c != nullptr,
-                        warm ? &c->sphereOverlapping : nullptr, warm ? &c->sphereSeparated : nullptr);
+                        warm ? &c->sphereOverlapping : nullptr, warm ? &c->sphereSeparated : nullptr,
+                        model == ContactModel::kExact ? kExactDirectPairs : 0);
     fillFrontier(s.sphereFront, sa, sb, result);
     if (model == ContactModel::kExact) {
       const bool complete =
@@ -797,10 +822,10 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
     }
     for (Contact& ct : s.raw) ct = toWorld(ct, xfWorldFromA);
   } else {
-    const CellSide sa{a.contactTree()};
-    const CellSide sb{b.contactTree()};
+    const CellSide sa{a.contactTree(), settings.maxLevel};
+    const CellSide sb{b.contactTree(), settings.maxLevel};
     finished = traverse(sa, sb, xfAFromB, meter, s.cellFront, s.cellNext, s.cellSeparated, c != nullptr,
-                        warm ? &c->cellOverlapping : nullptr, warm ? &c->cellSeparated : nullptr);
+                        warm ? &c->cellOverlapping : nullptr, warm ? &c->cellSeparated : nullptr, 0);
     fillFrontier(s.cellFront, sa, sb, result);
     ContactSamplingSettings sampling = settings.contactSampling;
     sampling.maxDepth = kContactTreeLeafDepth;
