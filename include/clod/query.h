@@ -67,6 +67,11 @@ struct QuerySettings {
   /// Contact sampling of the contact-tree model. Its maxDepth is ignored (the traversal decides
   /// how deep to go) and its own per-patch thinning is not applied: the manifold reduction is.
   ContactSamplingSettings contactSampling;
+  /// Deepest hierarchy level the traversal descends to (0 = the roots): nodes at this level count
+  /// as leaves, so the answer is the one "resolved at level maxLevel" (the papers' experiments).
+  /// Sphere models: sphere level; contact-tree: cell depth; ignored by the exact model (it needs
+  /// the leaves' triangles). Default: no cap.
+  std::uint32_t maxLevel = UINT32_MAX;
 };
 
 /// Why a query stopped.
