@@ -7,7 +7,7 @@ set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config
   libeigen3-dev libassimp-dev libtbb-dev nlohmann-json3-dev libcli11-dev libqhull-dev libxxhash-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libtinygltf-dev gnuplot-nox chromium)
+  libtinygltf-dev gnuplot-nox chromium nodejs)
 for arg in "$@"; do
   case "$arg" in
     --peers) packages+=(libcgal-dev libembree-dev libfcl-dev libbullet-dev libopenvdb-dev) ;;
@@ -19,6 +19,8 @@ missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# npm ships inside some nodejs builds (NodeSource) and separately in Debian's: ask for it only when absent.
+command -v npm >/dev/null 2>&1 || missing+=(npm)
 if ((${#missing[@]})); then
   echo "install-deps.sh: installing ${missing[*]}"
   sudo_cmd=""

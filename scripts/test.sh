@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The README's test command: install missing packages, build (Release), run the whole test suite.
+# The README's test command: install missing packages, build (Release), run the whole test suite
+# and the web viewer's browser test.
 # With --sanitize, a second build under AddressSanitizer + UndefinedBehaviorSanitizer runs it too.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -8,6 +9,7 @@ jobs=$(nproc)
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCLOD_BUILD_TESTS=ON
 cmake --build build -j "$jobs"
 ctest --test-dir build -j "$jobs" --output-on-failure
+scripts/test-viewer.sh build/bin/clod  # the web viewer in headless Chromium (docs/viewer.md)
 if [[ "${1:-}" == "--sanitize" ]]; then
   cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCLOD_SANITIZE=ON -DCLOD_BUILD_TESTS=ON
   cmake --build build-asan -j "$jobs"
