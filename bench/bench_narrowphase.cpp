@@ -14,12 +14,15 @@
 // of the diagonal deeper, "deep" 15 % deeper, "separated" 5 % beyond touching.
 // Counters: contacts, tests (clod), finished (clod).
 //
-// Accuracy harness: run with --accuracy[=N] (N random touching poses per mesh, default 500).
+// Accuracy harness: run with --accuracy[=N] (N random touching poses per mesh, default 2000), and
+// --accuracy-data=FILE to also write the medians as whitespace-separated columns for gnuplot
+// (docs/benchmarks/narrowphase_accuracy.gp).
 // For every pose (random rotation of B, random direction, bisection to touching, then 0.5 % of the
 // diagonal deeper) every model and budget, FCL and Bullet are timed once and compared with the
 // exact model at full budget: normal error = angle between depth-weighted resultant normals;
-// point error = distance between the manifolds' centroids, in units of the diagonal. Prints a
-// markdown table of medians and 95th percentiles.
+// depth error = |deepest contact's depth - the exact depth|; point error = distance between the
+// manifolds' centroids; lengths in units of the diagonal (1). Times are this thread's CPU time of
+// the one call. Prints a markdown table of medians and 95th percentiles.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -27,6 +30,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <memory>
 #include <random>
 #include <string>
@@ -242,7 +246,7 @@ struct BulletScene {
     world.addCollisionObject(&b);
   }
   // Returns the number of manifold points; fills the depth-weighted normal (B -> A) and centroid.
-  int step(Vec3* normal = nullptr, Vec3* centroid = nullptr) {
+  int step(Vec3* normal = nullptr, Vec3* centroid = nullptr, double* depth = nullptr) {
     world.performDiscreteCollisionDetection();
     int points = 0;
     Vec3 n = Vec3::Zero(), c = Vec3::Zero();
@@ -256,6 +260,7 @@ struct BulletScene {
         ++points;
         const btVector3 nb = p.m_normalWorldOnB * (flipped ? -1 : 1);
         const double w = std::max(-static_cast<double>(p.getDistance()), 1e-12);
+        if (depth) *depth = std::max(*depth, -static_cast<double>(p.getDistance()));
         n += w * Vec3(nb.x(), nb.y(), nb.z());
         const btVector3 pos = p.getPositionWorldOnB();
         c += Vec3(pos.x(), pos.y(), pos.z());
@@ -293,9 +298,22 @@ Vec3 centroid(const std::vector<Contact>& contacts) {
 }
 
 struct Samples {
-  std::vector<double> angle, point, micros;
+  std::vector<double> angle, point, depth, micros;
   int missed = 0;
 };
+
+// CPU time of this thread: under the shared machine's load, wall time measures the neighbours.
+double threadSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+double maxDepth(const std::vector<Contact>& contacts) {
+  double d = 0.0;
+  for (const Contact& c : contacts) d = std::max(d, c.depth);
+  return d;
+}
 
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return std::nan("");
@@ -303,9 +321,13 @@ double percentile(std::vector<double> v, double q) {
   return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5))];
 }
 
-void runAccuracy(int poses) {
-  std::printf("| mesh | method | budget | median time (us) | normal error median (deg) | p95 (deg) | point error median (diag) | p95 (diag) | no contact |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|\n");
+void runAccuracy(int poses, const char* dataPath) {
+  std::FILE* data = dataPath != nullptr ? std::fopen(dataPath, "w") : nullptr;
+  if (data != nullptr) {
+    std::fprintf(data, "# budget 0 = unlimited; FCL/Bullet rows have budget -\n# mesh method budget time_us_median normal_deg_median normal_deg_p95 depth_err_median point_err_median\n");
+  }
+  std::printf("| mesh | method | budget | median CPU time (us) | normal error median (deg) | p95 (deg) | depth error median (diag) | p95 (diag) | point error median (diag) | p95 (diag) | no contact |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (int mesh = 0; mesh < 3; ++mesh) {
     const CollisionBody& a = *body(mesh).body;
     std::mt19937_64 rng(1234 + mesh);
@@ -326,7 +348,8 @@ void runAccuracy(int poses) {
       if (exact.contacts.empty()) continue;
       const Vec3 nRef = resultantNormal(exact.contacts);
       const Vec3 cRef = centroid(exact.contacts);
-      auto record = [&](Samples& out, double seconds, bool any, const Vec3& n, const Vec3& c) {
+      const double dRef = maxDepth(exact.contacts);
+      auto record = [&](Samples& out, double seconds, bool any, const Vec3& n, const Vec3& c, double depth) {
         out.micros.push_back(seconds * 1e6);
         if (!any) {
           ++out.missed;
@@ -334,51 +357,66 @@ void runAccuracy(int poses) {
         }
         out.angle.push_back(std::acos(std::clamp(n.dot(nRef), -1.0, 1.0)) * 180.0 / 3.14159265358979323846);
         out.point.push_back((c - cRef).norm());
+        out.depth.push_back(std::abs(depth - dRef));
       };
       int m = 0;
       for (ContactModel model : allContactModels()) {
         for (std::uint64_t budget : kBudgets) {
           s.model = model;
           s.budget.maxTests = budget;
+          const double t0 = threadSeconds();
           queryContacts(a, Pose{}, a, pb, s, scratch, r);
-          record(samples[m++], r.seconds, !r.contacts.empty(), r.contacts.empty() ? Vec3::Zero() : resultantNormal(r.contacts),
-                 r.contacts.empty() ? Vec3::Zero() : centroid(r.contacts));
+          const double seconds = threadSeconds() - t0;
+          record(samples[m++], seconds, !r.contacts.empty(), r.contacts.empty() ? Vec3::Zero() : resultantNormal(r.contacts),
+                 r.contacts.empty() ? Vec3::Zero() : centroid(r.contacts), maxDepth(r.contacts));
         }
       }
 #if defined(CLOD_BENCH_HAVE_FCL)
       {
         fcl::CollisionResultd fr;
-        const auto t0 = std::chrono::steady_clock::now();
+        const double t0 = threadSeconds();
         const std::size_t n = fclCollide(mesh, pb, fr);
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const double seconds = threadSeconds() - t0;
         Vec3 normal = Vec3::Zero(), c = Vec3::Zero();
+        double depth = 0.0;
         for (std::size_t i = 0; i < n; ++i) {
           const auto& contact = fr.getContact(i);
           // FCL's normal points from o1 (A) to o2 (B); ours from B to A. Unweighted: FCL's
-          // mesh-mesh contacts carry no meaningful depth.
+          // mesh-mesh contacts carry no meaningful depth (its penetration_depth is per
+          // triangle pair; the largest is reported as its depth).
           normal -= contact.normal;
           c += contact.pos;
+          depth = std::max(depth, contact.penetration_depth);
         }
-        record(samples[25], seconds, n > 0 && normal.norm() > 0, normal.normalized(), n > 0 ? Vec3(c / double(n)) : c);
+        record(samples[25], seconds, n > 0 && normal.norm() > 0, normal.normalized(), n > 0 ? Vec3(c / double(n)) : c, depth);
       }
 #endif
 #if defined(CLOD_BENCH_HAVE_BULLET)
       {
         BulletScene scene(mesh, pb);
         Vec3 normal = Vec3::Zero(), c = Vec3::Zero();
-        const auto t0 = std::chrono::steady_clock::now();
-        const int n = scene.step(&normal, &c);
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        record(samples[26], seconds, n > 0, normal, c);
+        double depth = 0.0;
+        const double t0 = threadSeconds();
+        const int n = scene.step(&normal, &c, &depth);
+        const double seconds = threadSeconds() - t0;
+        record(samples[26], seconds, n > 0, normal, c, depth);
       }
 #endif
     }
     int m = 0;
     auto row = [&](const std::string& method, const std::string& budget, const Samples& x) {
       if (x.micros.empty()) return;
-      std::printf("| %s | %s | %s | %.1f | %.2f | %.2f | %.4f | %.4f | %d of %zu |\n", kMeshNames[mesh], method.c_str(),
-                  budget.c_str(), percentile(x.micros, 0.5), percentile(x.angle, 0.5), percentile(x.angle, 0.95),
-                  percentile(x.point, 0.5), percentile(x.point, 0.95), x.missed, x.micros.size());
+      std::printf("| %s | %s | %s | %.1f | %.2f | %.2f | %.4f | %.4f | %.4f | %.4f | %d of %zu |\n", kMeshNames[mesh],
+                  method.c_str(), budget.c_str(), percentile(x.micros, 0.5), percentile(x.angle, 0.5),
+                  percentile(x.angle, 0.95), percentile(x.depth, 0.5), percentile(x.depth, 0.95), percentile(x.point, 0.5),
+                  percentile(x.point, 0.95), x.missed, x.micros.size());
+      if (data != nullptr) {
+        std::string tag = method;
+        std::replace(tag.begin(), tag.end(), ' ', '_');
+        std::fprintf(data, "%s %s %s %.3f %.3f %.3f %.5f %.5f\n", kMeshNames[mesh], tag.c_str(),
+                     budget == "unlimited" ? "0" : budget.c_str(), percentile(x.micros, 0.5), percentile(x.angle, 0.5),
+                     percentile(x.angle, 0.95), percentile(x.depth, 0.5), percentile(x.point, 0.5));
+      }
     };
     for (ContactModel model : allContactModels()) {
       for (std::uint64_t budget : kBudgets) {
@@ -388,15 +426,20 @@ void runAccuracy(int poses) {
     row("FCL OBBRSS", "-", samples[25]);
     row("Bullet GImpact", "-", samples[26]);
   }
+  if (data != nullptr) std::fclose(data);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  const char* dataPath = nullptr;
   for (int i = 1; i < argc; ++i) {
-    if (std::strncmp(argv[i], "--accuracy", 10) == 0) {
-      const int poses = argv[i][10] == '=' ? std::atoi(argv[i] + 11) : 500;
-      runAccuracy(std::max(1, poses));
+    if (std::strncmp(argv[i], "--accuracy-data=", 16) == 0) dataPath = argv[i] + 16;
+  }
+  for (int i = 1; i < argc; ++i) {
+    if (std::strncmp(argv[i], "--accuracy", 10) == 0 && std::strncmp(argv[i], "--accuracy-data", 15) != 0) {
+      const int poses = argv[i][10] == '=' ? std::atoi(argv[i] + 11) : 2000;
+      runAccuracy(std::max(1, poses), dataPath);
       return 0;
     }
   }
