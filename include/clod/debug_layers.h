@@ -71,8 +71,9 @@ struct CfmSampleLevel {
   std::vector<float> normals;
 };
 
-/// Contact-tree cells the surface crosses (those with a half-space): cx cy cz half depth per
-/// cell (centre, half the side length, octree depth), and the cell's half-space nx ny nz offset.
+/// Contact-tree surface cells (those with a half-space: the surface comes within half a cell
+/// diagonal of the centre, docs/contact-tree.md): cx cy cz half depth per cell (centre, half the
+/// side length, octree depth), and the cell's half-space nx ny nz offset.
 struct ContactTreeLayer {
   std::vector<float> cells;
   std::vector<float> halfSpaces;
