@@ -161,6 +161,28 @@ void BM_ContactTree_Sample(benchmark::State& state) {
 }
 BENCHMARK(BM_ContactTree_Sample)->ArgsProduct({{0, 1}, {3, 4}});
 
+// The same queries on a copy of the tree without its lookup grid (descent from the root):
+// what the grid buys, measured in the same run.
+void BM_ContactTree_SampleNoGrid(benchmark::State& state) {
+  const std::string name = kMeshes[state.range(0)];
+  ContactTree tree = cachedTree(name, state.range(1));
+  tree.gridDepth = 0;
+  tree.gridNode.clear();
+  tree.gridCorners.clear();
+  const auto& points = meshData(name).queryPoints;
+  std::size_t i = 0;
+  double sum = 0.0;
+  for (auto _ : state) {
+    const ContactFieldSample s = tree.sample(points[i]);
+    sum += s.distance + s.gradient.x();
+    i = (i + 1) & (points.size() - 1);
+  }
+  benchmark::DoNotOptimize(sum);
+  state.SetLabel(name);
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_ContactTree_SampleNoGrid)->ArgsProduct({{0, 1}, {3, 4}});
+
 // Distance only, stopped at depth 6: what a budget-limited query costs.
 void BM_ContactTree_SampleDepth6(benchmark::State& state) {
   const std::string name = kMeshes[state.range(0)];

@@ -137,10 +137,9 @@ ContactFieldSample ContactTree::sample(const Vec3& p, std::uint32_t maxDepthQuer
   // 8 cases), instead of copying 8 values at every level.
   //
   // The descent is a chain of dependent loads (firstChild of the next level needs this one's),
-  // so its cost is memory latency, not arithmetic. Two things shorten the chain: the lookup
-  // grid replaces the top gridDepth levels by one load, and each level's lattice block is
-  // prefetched as soon as its address is known, so the final corner loads overlap the last
-  // firstChild load instead of following it.
+  // so its cost is memory latency, not arithmetic. The lookup grid replaces the top gridDepth
+  // levels by one load. (Prefetching every level's lattice block, to overlap the final corner
+  // loads with the last firstChild load, measured slower: it doubles the lines in flight.)
   const float* blocks[32];
   std::uint8_t octants[32];
   std::uint32_t node = 0;
@@ -163,8 +162,6 @@ ContactFieldSample ContactTree::sample(const Vec3& p, std::uint32_t maxDepthQuer
         ((fixed[0] >> bit) & 1u) | (((fixed[1] >> bit) & 1u) << 1) | (((fixed[2] >> bit) & 1u) << 2);
     ++depth;
     const float* block = pool + std::size_t{(first - 1) >> 3} * kContactTreeLatticePerNode;
-    __builtin_prefetch(block);
-    __builtin_prefetch(block + kContactTreeLatticePerNode - 1);
     blocks[depth] = block;
     octants[depth] = static_cast<std::uint8_t>(octant);
     node = first + octant;

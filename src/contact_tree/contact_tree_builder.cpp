@@ -82,6 +82,9 @@ public:
 private:
   // True when the cell must be measured; otherwise fills r as a proven-far leaf.
   bool needsMeasuring(const PendingCell& cell, std::uint32_t depth, CellResult& r) const;
+  // Sign of the exact distance at local position t (cell units) of `cell` when a corner value
+  // proves it, else 0.
+  int inferSign(const PendingCell& cell, std::uint32_t depth, const Vec3& t) const;
   // Exact signed distance at local position t (cell units) of `cell`, see the sign inference.
   MeshDistance::Signed exactQuery(const PendingCell& cell, std::uint32_t depth, const Vec3& t) const;
   // The rest of the refinement test, given the exact values at the cell's 18 shared lattice
@@ -124,21 +127,25 @@ bool Builder::needsMeasuring(const PendingCell& cell, std::uint32_t depth, CellR
   return true;
 }
 
-MeshDistance::Signed Builder::exactQuery(const PendingCell& cell, std::uint32_t depth, const Vec3& t) const {
+int Builder::inferSign(const PendingCell& cell, std::uint32_t depth, const Vec3& t) const {
   // The sign is the expensive part of an exact query for open meshes (a winding number), and
   // often it is already known: if a corner value v has |v| > |x - corner|, d(x) has v's sign,
   // since |d(x) - v| <= |x - corner|. Then only the unsigned distance is needed.
   const double h = tree_.cellSize(depth);
-  const Vec3 p = tree_.origin + h * (Vec3(cell.index[0], cell.index[1], cell.index[2]) + t);
   for (int c = 0; c < 8; ++c) {
     const double reach = h * (t - Vec3(c & 1, (c >> 1) & 1, (c >> 2) & 1)).norm();
     const double v = cell.corners[c];
-    if (std::abs(v) * (1.0 - 1e-6) > reach + 1e-9 * h) {
-      const ClosestPoint closest = distance_.closestPoint(p);
-      return {closest, v < 0.0 ? -closest.distance : closest.distance};
-    }
+    if (std::abs(v) * (1.0 - 1e-6) > reach + 1e-9 * h) return v < 0.0 ? -1 : 1;
   }
-  return distance_.signedQuery(p);
+  return 0;
+}
+
+MeshDistance::Signed Builder::exactQuery(const PendingCell& cell, std::uint32_t depth, const Vec3& t) const {
+  const Vec3 p = tree_.origin + tree_.cellSize(depth) * (Vec3(cell.index[0], cell.index[1], cell.index[2]) + t);
+  const int sign = inferSign(cell, depth, t);
+  if (sign == 0) return distance_.signedQuery(p);
+  const ClosestPoint closest = distance_.closestPoint(p);
+  return {closest, sign * closest.distance};
 }
 
 std::uint64_t Builder::measureChunk(const std::vector<PendingCell>& frontier, std::size_t begin, std::size_t end,
@@ -167,11 +174,29 @@ std::uint64_t Builder::measureChunk(const std::vector<PendingCell>& frontier, st
   groupStarts_.push_back(requests_.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groupStarts_.size() - 1, 64), [&](const tbb::blocked_range<std::size_t>& range) {
     for (std::size_t g = range.begin(); g != range.end(); ++g) {
+      // The unsigned distance is shared; the sign is inferred per requesting cell from its own
+      // corners, exactly as if the cell had evaluated the point itself. (Inferring it once for
+      // all would differ across the sign jump of an open mesh's winding-number membrane, where
+      // the field is not 1-Lipschitz: neighbours would disagree about the jump's position.)
+      // The winding-number sign is computed at most once per point.
       const LatticeRequest& owner = requests_[groupStarts_[g]];
-      const int l = static_cast<int>(owner.lattice);
-      const double value = exactQuery(frontier[begin + owner.cell], depth, 0.5 * Vec3(l % 3, (l / 3) % 3, l / 9)).signedDistance;
-      for (std::size_t r = groupStarts_[g]; r < groupStarts_[g + 1]; ++r)
-        exactScratch_[std::size_t{requests_[r].cell} * kLatticeSize + requests_[r].lattice] = value;
+      const PendingCell& ownerCell = frontier[begin + owner.cell];
+      const int lo = static_cast<int>(owner.lattice);
+      const Vec3 p = tree_.origin + tree_.cellSize(depth) * (Vec3(ownerCell.index[0], ownerCell.index[1], ownerCell.index[2]) +
+                                                             0.5 * Vec3(lo % 3, (lo / 3) % 3, lo / 9));
+      const double unsignedDistance = distance_.closestPoint(p).distance;
+      double windingSigned = 0.0;
+      bool haveWinding = false;
+      for (std::size_t r = groupStarts_[g]; r < groupStarts_[g + 1]; ++r) {
+        const int l = static_cast<int>(requests_[r].lattice);
+        const int sign = inferSign(frontier[begin + requests_[r].cell], depth, 0.5 * Vec3(l % 3, (l / 3) % 3, l / 9));
+        if (sign == 0 && !haveWinding) {
+          windingSigned = distance_.signedQuery(p).signedDistance;
+          haveWinding = true;
+        }
+        exactScratch_[std::size_t{requests_[r].cell} * kLatticeSize + requests_[r].lattice] =
+            sign == 0 ? windingSigned : sign * unsignedDistance;
+      }
     }
   });
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 8), [&](const tbb::blocked_range<std::size_t>& range) {
