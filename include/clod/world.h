@@ -11,20 +11,28 @@
 //   2. per substep: gravity; broad phase (sweep and prune over world boxes of the root spheres);
 //      budget division among the candidate pairs (below); narrow phase (queryContacts) per pair;
 //      velocity solve (normal + 2 friction directions per contact, accumulated impulses clamped,
-//      warm started from the previous substep's contacts of the same pair matched by proximity);
+//      warm started from the previous substep's contacts of the same pair, matched one-to-one by
+//      proximity and normal; pairs solved in a fixed order of body ids);
 //      restitution only above WorldSettings::restitutionThreshold; penetration removed by a
 //      separate pseudo-velocity solve (split impulses) that moves positions but never enters the
 //      velocities, so correction adds no kinetic energy; integration (semi-implicit Euler for
 //      positions; angular momentum kept exactly through rotation, see docs/dynamics.md).
 //
-// Budget division (the time-critical part): the candidate pairs are ranked first by how many
-// substeps they have gone without a query (round robin: a starved pair moves to the front), then
-// by priority = approach speed along last contact normal + last deepest depth / dt. Walking down
-// the list, each pair gets share = remaining / pairs left (at least 1 test), and what a pair
-// does not use rolls over to the pairs after it. When the budget is gone, the remaining pairs are
-// not queried this substep: they keep their last contacts (graceful fallback) and are reported
-// as skipped. Each pair keeps a CoherenceCache, so an interrupted pair resumes from the level it
-// reached next time. Hence a substep makes at most max(budget, number of pairs) tests.
+// Budget division (the time-critical part): WorldSettings::budgetTests is per step (frame). A
+// substep may spend ceil(tests the step has left / substeps left). Within a substep the
+// candidate pairs are ranked first by how many substeps they have gone without a query (round
+// robin: a starved pair moves to the front), then by priority = approach speed along last contact
+// normal + last deepest depth / dt. Walking down the list, each pair gets share = remaining /
+// pairs left (at least 1 test while any is left), and what a pair does not use rolls over to the
+// pairs after it. When the budget is gone, the remaining pairs are not queried: they keep their
+// last contacts (graceful fallback) and are reported as skipped. Each pair keeps a
+// CoherenceCache, so an interrupted pair resumes from the level it reached next time. Hence a
+// step makes at most budgetTests tests.
+//
+// Energy: the velocity solve is checked -- if the warm-started solve ends with more kinetic energy
+// than it started with, it is redone from zero impulses -- and the restitution impulses are scaled
+// so that they return at most e^2 of the energy the compression phase removed (energetic
+// restitution, Stronge 1990). So contacts never add kinetic energy, at any iteration count.
 //
 // Determinism: everything runs on one thread in a fixed order; the same scene and settings give
 // bit-identical states on the same build.
@@ -48,7 +56,9 @@ using BodyId = std::uint32_t;
 struct WorldSettings {
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);  ///< may be zero
   ContactModel model = ContactModel::kCfm;
-  /// Sphere/triangle tests per substep for all pairs together; 0 = unlimited.
+  /// Sphere/triangle tests per step (per World::step, i.e. per frame) for all pairs and all
+  /// substeps together; 0 = unlimited. A step never spends more. Each substep gets an equal
+  /// share of what the step has left (rounded up); what it does not spend rolls over.
   std::uint64_t budgetTests = 0;
   /// Manifold size per pair (QuerySettings::maxContacts), >= 1.
   std::uint32_t maxContacts = 8;
@@ -65,6 +75,8 @@ struct WorldSettings {
   /// body's bounding-box diagonal.
   double correctionFactor = 0.2;
   double slopRel = 0.002;
+  /// Narrow-phase level cap for every pair (QuerySettings::maxLevel); default: no cap.
+  std::uint32_t maxLevel = UINT32_MAX;
   /// At most this many substeps per step (>= 1).
   std::uint32_t maxSubsteps = 128;
   /// Bodies whose centre of mass leaves this box are reported in StepReport::leftBounds
@@ -87,10 +99,13 @@ struct StepReport {
   std::uint32_t substeps = 0;
   std::uint64_t candidatePairs = 0;  ///< broad-phase pairs, summed over substeps
   std::uint64_t testsSpent = 0;      ///< narrow-phase tests, all pairs and substeps
-  std::uint64_t testsBudget = 0;     ///< budgetTests * substeps (0 = unlimited)
+  std::uint64_t testsBudget = 0;     ///< WorldSettings::budgetTests (0 = unlimited); testsSpent <= it
   std::uint64_t pairsSkipped = 0;    ///< pair queries skipped for lack of budget, summed
   std::uint64_t pairsInterrupted = 0;///< queries that stopped before the leaves, summed
   std::uint32_t solverIterations = 0;///< velocity iterations used, summed over substeps
+  /// Substeps whose warm-started velocity solve gained kinetic energy and was redone from zero
+  /// impulses (see world.h top; a sign of an unconverged solve).
+  std::uint32_t coldRestarts = 0;
   double narrowPhaseSeconds = 0.0;
   double solverSeconds = 0.0;
   std::vector<PairReport> pairs;     ///< pairs with contacts or queries this step, sorted (a, b)

@@ -19,6 +19,10 @@ namespace {
 // Fraction of the thinnest body's extent a body may travel per substep. Below 1/2 a body cannot
 // pass through a body as thick as that extent without overlapping it in some substep.
 constexpr double kTravelFraction = 0.25;
+// Split-impulse correction per substep at most this fraction of the smaller body's diagonal.
+constexpr double kMaxCorrectionRel = 0.02;
+// A previous contact passes its impulse on only to a new contact whose normal is within ~18 deg.
+constexpr double kWarmStartNormalCos = 0.95;
 
 bool finite(const Vec3& v) { return v.allFinite(); }
 
@@ -61,10 +65,11 @@ struct SolverContact {
   Contact c;
   Vec3 rA = Vec3::Zero(), rB = Vec3::Zero(), t1 = Vec3::UnitX(), t2 = Vec3::UnitY();
   double massN = 0, massT1 = 0, massT2 = 0;
-  double targetN = 0;     // restitution target for the normal relative velocity
+  double restitution = 0; // coefficient if this contact bounces this substep, else 0
   double targetPos = 0;   // pseudo-velocity target (split impulse)
   double lambdaN = 0, lambdaT1 = 0, lambdaT2 = 0, lambdaP = 0;
   Vec3 frictionImpulse = Vec3::Zero();  // world-frame tangential impulse, for warm starting
+  bool matched = false;                 // as a previous contact: already inherited by a new one
 };
 
 struct PairState {
@@ -74,6 +79,7 @@ struct PairState {
   std::uint32_t stale = 0;   // substeps since last query
   double priority = 0.0;
   bool seen = false;         // in this substep's broad phase
+  bool fresh = false;        // queried this substep (else: skipped, contacts kept)
 };
 
 std::uint64_t pairKey(BodyId a, BodyId b) { return (std::uint64_t(a) << 32) | b; }
@@ -99,6 +105,8 @@ struct World::Impl {
   QueryScratch scratch;
   QueryResult result;
   std::vector<std::pair<PairState*, std::array<BodyId, 2>>> order;
+  std::vector<std::pair<PairState*, std::array<BodyId, 2>>> solveOrder;
+  std::vector<Vec3> savedV, savedW, dV, dW;
   std::map<std::uint64_t, PairReport> pairReports;
 
   void validateSettings() const {
@@ -114,8 +122,10 @@ struct World::Impl {
     if (s.maxSubsteps == 0) bad("maxSubsteps must be >= 1");
   }
 
-  void substep(double h, std::uint64_t budget);
+  // limited == false: unlimited budget; else at most `allowance` tests this substep (0: none).
+  void substep(double h, bool limited, std::uint64_t allowance);
   void solve(double h);
+  double kineticEnergyOfDynamicBodies() const;
   void integrate(double h);
   void checkFinite() const;
 };
@@ -174,7 +184,7 @@ void World::Impl::checkFinite() const {
   }
 }
 
-void World::Impl::substep(double h, std::uint64_t budget) {
+void World::Impl::substep(double h, bool limited, std::uint64_t allowance) {
   const WorldSettings& s = settings;
   // Gravity first (semi-implicit Euler: the solver then sees the velocity contacts must stop).
   for (Body& b : bodies)
@@ -197,6 +207,7 @@ void World::Impl::substep(double h, std::uint64_t budget) {
   for (const BodyPair& c : candidates) {
     PairState& p = pairs[pairKey(c[0], c[1])];
     p.seen = true;
+    p.fresh = false;
     order.push_back({&p, {c[0], c[1]}});
   }
   // Pairs that left the broad phase forget their contacts and caches.
@@ -208,11 +219,12 @@ void World::Impl::substep(double h, std::uint64_t budget) {
     if (l.first->stale != r.first->stale) return l.first->stale > r.first->stale;
     return l.first->priority > r.first->priority;
   });
-  std::uint64_t remaining = budget;
+  std::uint64_t remaining = allowance;
   std::size_t left = order.size();
   QuerySettings qs;
   qs.model = s.model;
   qs.maxContacts = s.maxContacts;
+  qs.maxLevel = s.maxLevel;
   const auto t0 = std::chrono::steady_clock::now();
   for (auto& [p, ids] : order) {
     Body& a = bodies[ids[0]];
@@ -220,7 +232,7 @@ void World::Impl::substep(double h, std::uint64_t budget) {
     PairReport& pr = pairReports[pairKey(ids[0], ids[1])];
     pr.a = ids[0];
     pr.b = ids[1];
-    if (budget != 0) {
+    if (limited) {
       if (remaining == 0) {
         pr.skipped = true;
         ++report.pairsSkipped;
@@ -228,6 +240,7 @@ void World::Impl::substep(double h, std::uint64_t budget) {
         --left;
         continue;
       }
+      // share >= 1 and share <= remaining, so the substep never spends more than its allowance.
       qs.budget = QueryBudget::tests(std::max<std::uint64_t>(1, remaining / left));
     } else {
       qs.budget = QueryBudget::unlimited();
@@ -242,6 +255,7 @@ void World::Impl::substep(double h, std::uint64_t budget) {
     pr.skipped = false;
     if (!result.finished) ++report.pairsInterrupted;
     p->stale = 0;
+    p->fresh = true;
     p->previous.swap(p->contacts);
     p->contacts.clear();
     for (const Contact& c : result.contacts) {
@@ -252,17 +266,24 @@ void World::Impl::substep(double h, std::uint64_t budget) {
   }
   report.narrowPhaseSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  // Prepare constraints (points are world-frame; skipped pairs keep their last ones).
-  for (auto& [p, ids] : order) {
+  // The solver walks the pairs in a fixed order (by body ids), not in the budget's priority
+  // order: Gauss-Seidel results depend on the order, and an order that changes from substep to
+  // substep makes resting contact jitter (a stack then walks sideways).
+  solveOrder.assign(order.begin(), order.end());
+  std::sort(solveOrder.begin(), solveOrder.end(), [](const auto& l, const auto& r) { return l.second < r.second; });
+
+  // Prepare constraints (points are world-frame; skipped pairs keep their last ones). Everything
+  // that depends on the velocities is read before any warm-start impulse is applied, so it does
+  // not depend on the pair order.
+  for (auto& [p, ids] : solveOrder) {
     Body& a = bodies[ids[0]];
     Body& b = bodies[ids[1]];
     const double restitution = std::max(a.desc.restitution, b.desc.restitution);
-    const double mu = std::sqrt(a.desc.friction * b.desc.friction);
-    (void)mu;
     const double diag = std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal());
     const double matchDistance = 0.05 * diag;
     double maxDepth = 0.0;
     double approach = 0.0;
+    for (auto& old : p->previous) old.matched = false;
     for (SolverContact& cp : p->contacts) {
       const Vec3& n = cp.c.normal;
       cp.rA = cp.c.point - a.x;
@@ -279,27 +300,40 @@ void World::Impl::substep(double h, std::uint64_t budget) {
       const Vec3 vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
       const double vn = vr.dot(n);
       // Restitution by Poisson's hypothesis, applied after the velocity iterations: the solver
-      // first stops the approach (compression impulse), then adds restitution x that impulse.
-      // For frictionless contact this never gains energy, even with many simultaneous contacts
-      // (Stronge, "Impact Mechanics", 2000), unlike per-point velocity targets.
-      cp.targetN = vn < -s.restitutionThreshold ? restitution : 0.0;
+      // first stops the approach (compression impulse), then adds restitution x that impulse
+      // (Stronge, "Impact Mechanics", 2000). Decided once, from the pre-solve approach speed.
+      cp.restitution = vn < -s.restitutionThreshold ? restitution : 0.0;
       // Only the part of the depth that is certain is corrected: a sphere-model contact may be
       // off by its errorBound (the surfaces lie somewhere inside both spheres), so correcting it
-      // would push bodies apart that do not touch (docs/dynamics.md).
-      // The contact tree's depth comes from its distance field (errorBound there is the field's
-      // interpolation error, not a doubt about contact), so it is corrected as it is.
+      // would push bodies apart that do not touch (docs/dynamics.md). The contact tree's depth
+      // comes from its distance field (errorBound there is the field's interpolation error, not
+      // a doubt about contact), so it is corrected as it is.
       const double doubt = s.model == ContactModel::kContactTree ? 0.0 : cp.c.errorBound;
       const double certain = cp.c.depth - doubt - s.slopRel * diag;
-      cp.targetPos = certain > 0.0 ? s.correctionFactor * certain / h : 0.0;
+      // Correction speed capped: a coarse contact's depth can be a large part of a body, and
+      // removing a fifth of it per substep would teleport a small body through its neighbours.
+      const double maxCorrection = kMaxCorrectionRel * diag;
+      cp.targetPos = certain > 0.0 ? std::min(s.correctionFactor * certain, maxCorrection) / h : 0.0;
       maxDepth = std::max(maxDepth, cp.c.depth);
       approach = std::max(approach, -vn);
-      // Warm start from the nearest previous contact of this pair.
-      // Only resting contact is warm started: re-applying last substep's impulse to a pair that
-      // is now separating fast (after a bounce) would add energy the iterations may not remove.
-      if (cp.lambdaN == 0.0 && std::abs(vn) < s.restitutionThreshold) {
+      // Warm start only resting contact: re-applying last substep's impulse to a pair that is now
+      // separating or approaching fast (a bounce) adds energy the iterations may not remove.
+      const bool resting = std::abs(vn) < s.restitutionThreshold;
+      if (!p->fresh) {
+        // Kept contacts of a pair the budget skipped: their own impulses, if still resting.
+        if (!resting) cp.lambdaN = cp.lambdaT1 = cp.lambdaT2 = 0.0;
+        else {
+          cp.lambdaT1 = cp.frictionImpulse.dot(cp.t1);
+          cp.lambdaT2 = cp.frictionImpulse.dot(cp.t2);
+        }
+      } else if (resting) {
+        // A fresh contact inherits the impulse of the nearest unclaimed previous contact of
+        // this pair with nearly the same normal; one-to-one, so a manifold that grew does not
+        // apply one old impulse twice.
         double best = matchDistance;
-        const SolverContact* match = nullptr;
-        for (const SolverContact& old : p->previous) {
+        SolverContact* match = nullptr;
+        for (SolverContact& old : p->previous) {
+          if (old.matched || old.c.normal.dot(n) < kWarmStartNormalCos) continue;
           const double d = (old.c.point - cp.c.point).norm();
           if (d < best) {
             best = d;
@@ -307,22 +341,28 @@ void World::Impl::substep(double h, std::uint64_t budget) {
           }
         }
         if (match) {
+          match->matched = true;
           cp.lambdaN = match->lambdaN;
           cp.lambdaT1 = match->frictionImpulse.dot(cp.t1);
           cp.lambdaT2 = match->frictionImpulse.dot(cp.t2);
         }
       }
       cp.lambdaP = 0.0;
-      const Vec3 impulse = cp.lambdaN * n + cp.lambdaT1 * cp.t1 + cp.lambdaT2 * cp.t2;
-      a.v += a.invMass * impulse;
-      a.w += a.invInertiaWorld * cp.rA.cross(impulse);
-      b.v -= b.invMass * impulse;
-      b.w -= b.invInertiaWorld * cp.rB.cross(impulse);
     }
     p->priority = approach + maxDepth / h;
   }
   solve(h);
   integrate(h);
+}
+
+double World::Impl::kineticEnergyOfDynamicBodies() const {
+  double e = 0.0;
+  for (const Body& b : bodies)
+    if (b.type == BodyType::kDynamic) {
+      const Vec3 wl = b.q.conjugate() * b.w;
+      e += 0.5 * b.desc.mass * b.v.squaredNorm() + 0.5 * wl.dot(b.inertiaLocal * wl);
+    }
+  return e;
 }
 
 void World::Impl::solve(double h) {
@@ -335,47 +375,119 @@ void World::Impl::solve(double h) {
     b.v -= b.invMass * impulse;
     b.w -= b.invInertiaWorld * cp.rB.cross(impulse);
   };
-  std::uint32_t used = 0;
-  for (std::uint32_t it = 0; it < s.velocityIterations; ++it) {
-    ++used;
-    double maxChange = 0.0, maxLambda = 0.0;
-    for (auto& [p, ids] : order) {
-      Body& a = bodies[ids[0]];
-      Body& b = bodies[ids[1]];
-      const double mu = std::sqrt(a.desc.friction * b.desc.friction);
-      for (SolverContact& cp : p->contacts) {
-        // Friction first, limited by the current normal impulse (Catto 2005).
-        Vec3 vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
-        const double limit = mu * cp.lambdaN;
-        double old = cp.lambdaT1;
-        cp.lambdaT1 = std::clamp(old - cp.massT1 * vr.dot(cp.t1), -limit, limit);
-        apply(a, b, cp, (cp.lambdaT1 - old) * cp.t1);
-        maxChange = std::max(maxChange, std::abs(cp.lambdaT1 - old));
-        vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
-        old = cp.lambdaT2;
-        cp.lambdaT2 = std::clamp(old - cp.massT2 * vr.dot(cp.t2), -limit, limit);
-        apply(a, b, cp, (cp.lambdaT2 - old) * cp.t2);
-        maxChange = std::max(maxChange, std::abs(cp.lambdaT2 - old));
-        // Normal: accumulated impulse clamped to >= 0.
-        vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
-        old = cp.lambdaN;
-        cp.lambdaN = std::max(0.0, old - cp.massN * vr.dot(cp.c.normal));
-        apply(a, b, cp, (cp.lambdaN - old) * cp.c.normal);
-        maxChange = std::max(maxChange, std::abs(cp.lambdaN - old));
-        maxLambda = std::max(maxLambda, cp.lambdaN);
-      }
-    }
-    if (s.convergenceRel > 0.0 && maxChange <= s.convergenceRel * maxLambda) break;
+  // Velocities before the contact solve (gravity applied): the energy reference, and the state a
+  // cold restart goes back to.
+  const double energyBefore = kineticEnergyOfDynamicBodies();
+  savedV.resize(bodies.size());
+  savedW.resize(bodies.size());
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    savedV[i] = bodies[i].v;
+    savedW[i] = bodies[i].w;
   }
-  report.solverIterations += used;
-  for (auto& [p, ids] : order)
-    for (SolverContact& cp : p->contacts)
-      if (cp.targetN > 0.0) {
-        apply(bodies[ids[0]], bodies[ids[1]], cp, cp.targetN * cp.lambdaN * cp.c.normal);
-        cp.targetN = 0.0;  // a contact bounces once
+  auto iterate = [&](bool warm) {
+    if (warm)
+      for (auto& [p, ids] : solveOrder)
+        for (SolverContact& cp : p->contacts)
+          apply(bodies[ids[0]], bodies[ids[1]], cp, cp.lambdaN * cp.c.normal + cp.lambdaT1 * cp.t1 + cp.lambdaT2 * cp.t2);
+    std::uint32_t used = 0;
+    for (std::uint32_t it = 0; it < s.velocityIterations; ++it) {
+      ++used;
+      double maxChange = 0.0, maxLambda = 0.0;
+      for (auto& [p, ids] : solveOrder) {
+        Body& a = bodies[ids[0]];
+        Body& b = bodies[ids[1]];
+        const double mu = std::sqrt(a.desc.friction * b.desc.friction);
+        for (SolverContact& cp : p->contacts) {
+          // Friction first, limited by the current normal impulse; then the normal, so that
+          // non-penetration, the more important constraint, is solved last (Catto 2005).
+          Vec3 vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
+          const double limit = mu * cp.lambdaN;
+          double old = cp.lambdaT1;
+          cp.lambdaT1 = std::clamp(old - cp.massT1 * vr.dot(cp.t1), -limit, limit);
+          apply(a, b, cp, (cp.lambdaT1 - old) * cp.t1);
+          maxChange = std::max(maxChange, std::abs(cp.lambdaT1 - old));
+          vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
+          old = cp.lambdaT2;
+          cp.lambdaT2 = std::clamp(old - cp.massT2 * vr.dot(cp.t2), -limit, limit);
+          apply(a, b, cp, (cp.lambdaT2 - old) * cp.t2);
+          maxChange = std::max(maxChange, std::abs(cp.lambdaT2 - old));
+          vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
+          old = cp.lambdaN;
+          cp.lambdaN = std::max(0.0, old - cp.massN * vr.dot(cp.c.normal));
+          apply(a, b, cp, (cp.lambdaN - old) * cp.c.normal);
+          maxChange = std::max(maxChange, std::abs(cp.lambdaN - old));
+          maxLambda = std::max(maxLambda, cp.lambdaN);
+        }
       }
-  for (auto& [p, ids] : order)
-    for (SolverContact& cp : p->contacts) cp.frictionImpulse = cp.lambdaT1 * cp.t1 + cp.lambdaT2 * cp.t2;
+      if (s.convergenceRel > 0.0 && maxChange <= s.convergenceRel * maxLambda) break;
+    }
+    report.solverIterations += used;
+  };
+  iterate(true);
+  double energyCompressed = kineticEnergyOfDynamicBodies();
+  // A contact solve never adds kinetic energy at its solution (the impulses only stop approach,
+  // friction only dissipates). An unconverged solve that started from warm-start impulses can:
+  // then solve again from the pre-solve velocities without them (projected Gauss-Seidel from
+  // zero impulses only lowers the energy).
+  if (energyCompressed > energyBefore * (1.0 + 1e-12)) {
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      bodies[i].v = savedV[i];
+      bodies[i].w = savedW[i];
+    }
+    for (auto& [p, ids] : solveOrder)
+      for (SolverContact& cp : p->contacts) cp.lambdaN = cp.lambdaT1 = cp.lambdaT2 = 0.0;
+    iterate(false);
+    energyCompressed = kineticEnergyOfDynamicBodies();
+    ++report.coldRestarts;
+  }
+
+  // Restitution (Poisson): impulse e * lambda_c per bouncing contact. Exactly energy-safe only
+  // for a converged solve; so the restitution phase is scaled down, if needed, to give back at
+  // most e^2 times the energy the compression phase removed -- Stronge's energetic coefficient
+  // of restitution (Stronge 1990; equal to Poisson's for a converged frictionless solve, where
+  // the scale is 1).
+  double eMax = 0.0;
+  dV.assign(bodies.size(), Vec3::Zero());
+  dW.assign(bodies.size(), Vec3::Zero());
+  for (auto& [p, ids] : solveOrder)
+    for (const SolverContact& cp : p->contacts)
+      if (cp.restitution > 0.0 && cp.lambdaN > 0.0) {
+        const Body& a = bodies[ids[0]];
+        const Body& b = bodies[ids[1]];
+        const Vec3 impulse = cp.restitution * cp.lambdaN * cp.c.normal;
+        dV[ids[0]] += a.invMass * impulse;
+        dW[ids[0]] += a.invInertiaWorld * cp.rA.cross(impulse);
+        dV[ids[1]] -= b.invMass * impulse;
+        dW[ids[1]] -= b.invInertiaWorld * cp.rB.cross(impulse);
+        eMax = std::max(eMax, cp.restitution);
+      }
+  if (eMax > 0.0) {
+    // Kinetic energy after adding scale * (dV, dW): E + lin * scale + quad * scale^2.
+    double lin = 0.0, quad = 0.0;
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      const Body& b = bodies[i];
+      if (b.type != BodyType::kDynamic) continue;
+      const Mat3 r = b.q.toRotationMatrix();
+      const Mat3 inertiaWorld = r * b.inertiaLocal * r.transpose();
+      lin += b.desc.mass * b.v.dot(dV[i]) + b.w.dot(inertiaWorld * dW[i]);
+      quad += 0.5 * b.desc.mass * dV[i].squaredNorm() + 0.5 * dW[i].dot(inertiaWorld * dW[i]);
+    }
+    const double allowed = eMax * eMax * std::max(0.0, energyBefore - energyCompressed);
+    double scale = 1.0;
+    if (lin + quad > allowed) {
+      scale = quad > 0.0 ? (-lin + std::sqrt(std::max(0.0, lin * lin + 4.0 * quad * allowed))) / (2.0 * quad) : 0.0;
+      scale = std::clamp(scale, 0.0, 1.0);
+    }
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      bodies[i].v += scale * dV[i];
+      bodies[i].w += scale * dW[i];
+    }
+  }
+  for (auto& [p, ids] : solveOrder)
+    for (SolverContact& cp : p->contacts) {
+      cp.restitution = 0.0;  // a contact bounces once
+      cp.frictionImpulse = cp.lambdaT1 * cp.t1 + cp.lambdaT2 * cp.t2;
+    }
 
   // Split impulses: pseudo velocities that only move positions (never enter v, w).
   for (Body& b : bodies) {
@@ -383,7 +495,7 @@ void World::Impl::solve(double h) {
     b.wp.setZero();
   }
   for (std::uint32_t it = 0; it < s.positionIterations; ++it) {
-    for (auto& [p, ids] : order) {
+    for (auto& [p, ids] : solveOrder) {
       Body& a = bodies[ids[0]];
       Body& b = bodies[ids[1]];
       for (SolverContact& cp : p->contacts) {
@@ -453,10 +565,16 @@ const StepReport& World::step(double dt) {
     n = std::isfinite(want) ? std::uint32_t(std::clamp(want, 1.0, double(m.settings.maxSubsteps))) : m.settings.maxSubsteps;
   }
   m.report.substeps = n;
-  m.report.testsBudget = m.settings.budgetTests * n;
+  m.report.testsBudget = m.settings.budgetTests;
   const double h = dt / n;
+  // The budget is per step: each substep may spend an equal share of what the step has left,
+  // rounded up (so a substep with anything left gets at least one test), and what a substep
+  // does not spend rolls over to the next. The step never spends more than budgetTests.
+  const bool limited = m.settings.budgetTests != 0;
   for (std::uint32_t i = 0; i < n; ++i) {
-    m.substep(h, m.settings.budgetTests);
+    const std::uint64_t left = limited ? m.settings.budgetTests - std::min(m.settings.budgetTests, m.report.testsSpent) : 0;
+    const std::uint64_t substepsLeft = n - i;
+    m.substep(h, limited, (left + substepsLeft - 1) / substepsLeft);
     m.checkFinite();
   }
   for (auto& [key, pr] : m.pairReports) {

@@ -69,9 +69,8 @@ Collision collideCubes(double restitution, ContactModel model) {
   WorldSettings ws;
   ws.gravity = Vec3::Zero();
   ws.model = model;
-  // Poisson restitution provably adds no energy for the converged solution (world.cpp); 100
-  // iterations with the convergence check get there for 8 contacts (12 leave ~3e-4 excess).
-  ws.velocityIterations = 100;
+  // The default iteration count: the world must not gain energy whether or not the velocity
+  // solve converges (world.h, "Energy").
   World world(ws);
   RigidBodyDesc moving = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 2.0);
   moving.name = "moving";
@@ -119,14 +118,15 @@ TEST(World, BoxDroppedFlatComesToRestFlatWithEveryModelAndBudget) {
   const auto slab = bakeShape(makeBox(Vec3(2.0, 2.0, 0.25)));
   for (ContactModel model : {ContactModel::kCfm, ContactModel::kContactTree, ContactModel::kExact}) {
     for (std::uint64_t budget : {std::uint64_t(16), std::uint64_t(64), std::uint64_t(256), std::uint64_t(0)}) {
-      // Known failure (docs/dynamics.md): at 16 tests the contact tree stays at coarse cells and
-      // the box sinks 0.18 m into the slab before resting (flat). Reported, not hidden.
+      // Known failure of the narrow phase (docs/dynamics.md): at 16 tests per frame the
+      // contact-tree query never gets below coarse cells, whose contacts let the box come to rest
+      // (v = 0) 33.7 degrees tilted and 0.18 m deep in the slab (z 0.573) -- a resting tilted box
+      // is only possible with wrong contact normals/points. Reported, not hidden.
       if (model == ContactModel::kContactTree && budget == 16) continue;
-      // Known failure likewise: cfm at 256 tests rests 1.5 degrees tilted (limit 1).
-      if (model == ContactModel::kCfm && budget == 256) continue;
-      // Known failure since maps default to 16 root stacks: cfm at 16 and 64 tests rests 9.1 and
-      // 2.7 degrees tilted (edge spheres of both boxes map to side faces; docs/dynamics.md).
-      if (model == ContactModel::kCfm && (budget == 16 || budget == 64)) continue;
+      // Known failure of the narrow phase, being fixed there (docs/dynamics.md): cfm at 16 tests
+      // rests 8.1 degrees tilted (limit 1); the maps' normals of sphere pairs over the box edges
+      // are side-face normals (docs/narrow-phase.md). 64, 256 and unlimited pass.
+      if (model == ContactModel::kCfm && budget == 16) continue;
       WorldSettings ws;
       ws.model = model;
       ws.budgetTests = budget;
@@ -156,7 +156,8 @@ TEST(World, BoxDroppedFlatComesToRestFlatWithEveryModelAndBudget) {
   }
 }
 
-// Known failure (see docs/dynamics.md): the stack drifts sideways and topples after ~2 s.
+// Known failure (docs/dynamics.md): at the default 20 iterations the stack stands but rocks: the
+// top box moves 0.107 m (limit 0.01) and tilts up to ~1.5 degrees; 80 iterations: 0.024 m.
 TEST(World, DISABLED_StackOfTenBoxesStandsForTenSeconds) {
   const auto slab = bakeShape(makeBox(Vec3(3.0, 3.0, 0.25)));
   WorldSettings ws;
@@ -182,8 +183,15 @@ TEST(World, DISABLED_StackOfTenBoxesStandsForTenSeconds) {
   const Vec3 top0 = world.state(10).position;
   double maxMove = 0.0;
   for (int i = 0; i < steps; ++i) {
-    world.step(1.0 / 60.0);
+    const StepReport& r = world.step(1.0 / 60.0);
     maxMove = std::max(maxMove, (world.state(10).position - top0).norm());
+    if (std::getenv("CLOD_DEBUG_CONTACTS") && i % 30 == 0) {
+      for (std::size_t k = 0; k < r.contacts.size(); ++k)
+        std::printf("%d pair %u-%u p %.4f %.4f %.4f n %.5f %.5f %.5f d %.5f lvl %u\n", i, r.contactBodies[k][0],
+                    r.contactBodies[k][1], r.contacts[k].point.x(), r.contacts[k].point.y(), r.contacts[k].point.z(),
+                    r.contacts[k].normal.x(), r.contacts[k].normal.y(), r.contacts[k].normal.z(), r.contacts[k].depth,
+                    r.contacts[k].level);
+    }
     if (std::getenv("CLOD_DEBUG_STACK") && i % 30 == 0)
       for (int k = 1; k <= 10; ++k)
         std::printf("%d box%d %.4f %.4f %.4f tilt %.3f\n", i, k, world.state(k).position.x(), world.state(k).position.y(),
@@ -277,8 +285,9 @@ TEST(World, BudgetBoundsTheTestsOfEveryFrame) {
   std::uint64_t interrupted = 0;
   for (int i = 0; i < 90; ++i) {
     const StepReport& r = world.step(1.0 / 60.0);
-    // A substep makes at most max(budget, pairs) tests (a pair's share is at least 1 test).
-    EXPECT_LE(r.testsSpent, std::max<std::uint64_t>(r.testsBudget, r.candidatePairs)) << "step " << i;
+    // The budget is per step (frame), whatever the substeps and pairs.
+    EXPECT_EQ(r.testsBudget, 40u);
+    EXPECT_LE(r.testsSpent, r.testsBudget) << "step " << i;
     interrupted += r.pairsInterrupted + r.pairsSkipped;
   }
   EXPECT_GT(interrupted, 0u) << "the budget never bit: the test would prove nothing";
