@@ -1,6 +1,8 @@
 // Sphere-tree build time (single-threaded and all threads) and fit per level, for the shared
-// closed meshes and the 69k-triangle Stanford bunny, octree vs medial builder.
-//   BM_SphereTree_Build/<mesh>/<method>/<threads>   threads: 1, or 0 = all cores
+// closed meshes and the 69k-triangle Stanford bunny: octree, medial (default: per node the better
+// of merge/burst and k-means), medial-mergeburst (Bradshaw's merge/burst reduction alone) and
+// medial-kmeans (the earlier k-means reduction alone).
+//   BM_SphereTree_Build/<mesh>/<builder>/<threads>   threads: 1, or 0 = all cores
 // Counters: spheres per level (L<l>_spheres) and fit mean/max per level (L<l>_fitMean, L<l>_fitMax,
 // in units of the bounding-box diagonal), measured once outside the timed loop.
 #include <benchmark/benchmark.h>
@@ -31,13 +33,26 @@ const clod::MeshDistance& meshNamed(const std::string& name) {
   return *slot;
 }
 
-void buildBenchmark(benchmark::State& state, const std::string& mesh, clod::SphereTreeMethod method) {
+struct Builder {
+  const char* name;
+  clod::SphereTreeMethod method;
+  clod::MedialReduction reduction;
+};
+constexpr Builder kBuilders[] = {
+    {"octree", clod::SphereTreeMethod::kOctree, clod::MedialReduction::kBest},
+    {"medial", clod::SphereTreeMethod::kMedial, clod::MedialReduction::kBest},
+    {"medial-mergeburst", clod::SphereTreeMethod::kMedial, clod::MedialReduction::kMergeBurst},
+    {"medial-kmeans", clod::SphereTreeMethod::kMedial, clod::MedialReduction::kKMeans},
+};
+
+void buildBenchmark(benchmark::State& state, const std::string& mesh, const Builder& builder) {
   const clod::MeshDistance& distance = meshNamed(mesh);
   const int threads = static_cast<int>(state.range(0));
   std::unique_ptr<tbb::global_control> limit;
   if (threads > 0) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
   clod::SphereTreeSettings settings;
-  settings.method = method;
+  settings.method = builder.method;
+  settings.medialReduction = builder.reduction;
   clod::SphereTree tree;
   for (auto _ : state) {
     tree = clod::buildSphereTree(distance, settings);
@@ -58,11 +73,11 @@ void buildBenchmark(benchmark::State& state, const std::string& mesh, clod::Sphe
 
 const bool registered = [] {
   for (const char* mesh : {"stanford-bunny", "spot", "fandisk", "rocker-arm", "cow"})
-    for (clod::SphereTreeMethod method : {clod::SphereTreeMethod::kOctree, clod::SphereTreeMethod::kMedial}) {
+    for (const Builder& builder : kBuilders) {
       std::string name = "BM_SphereTree_Build/";
-      name.append(mesh).append("/").append(clod::sphereTreeMethodName(method));
-      benchmark::RegisterBenchmark(name.c_str(), [mesh = std::string(mesh), method](benchmark::State& state) {
-        buildBenchmark(state, mesh, method);
+      name.append(mesh).append("/").append(builder.name);
+      benchmark::RegisterBenchmark(name.c_str(), [mesh = std::string(mesh), &builder](benchmark::State& state) {
+        buildBenchmark(state, mesh, builder);
       })
           ->ArgName("threads")
           ->Arg(1)

@@ -7,6 +7,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <unordered_map>
 
 extern "C" {
 #include <libqhull_r/qhull_ra.h>
@@ -55,10 +56,14 @@ SurfaceSamples sampleSurface(const TriangleMesh& mesh, std::uint32_t target, std
   }
   s.poleCenter = s.position;
   s.poleRadius.assign(s.position.size(), 0.0);
+  s.poleId.resize(s.position.size());
+  for (std::uint32_t i = 0; i < s.size(); ++i) s.poleId[i] = i;
   return s;
 }
 
 namespace {
+
+constexpr unsigned kNoFacet = ~0u;
 
 // Circumcentre of a tetrahedron; false when it is (nearly) flat.
 bool circumcenter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Vec3& center) {
@@ -98,6 +103,7 @@ void computeInnerPoles(SurfaceSamples& samples, const Aabb& bounds) {
   // and circumcentres are computed from the exact sample positions anyway.
   char flags[] = "qhull d Qbb QJ";
   const int exitCode = qh_new_qhull(qh, 3, static_cast<int>(n), coords.data(), False, flags, nullptr, errorStream);
+  std::vector<unsigned> poleFacet(n, kNoFacet);
   if (exitCode == 0) {
     const double diagonal = bounds.diagonal();
     const Vec3 lo = bounds.min, hi = bounds.max;
@@ -131,8 +137,16 @@ void computeInnerPoles(SurfaceSamples& samples, const Aabb& bounds) {
         if (r > samples.poleRadius[id]) {
           samples.poleRadius[id] = r;
           samples.poleCenter[id] = c;
+          poleFacet[id] = facet->id;
         }
     }
+  }
+  // Compact ids: samples without a pole keep their own index, poles are numbered from n on.
+  std::unordered_map<unsigned, std::uint32_t> poleIndex;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (poleFacet[i] == kNoFacet) continue;
+    const auto inserted = poleIndex.emplace(poleFacet[i], n + static_cast<std::uint32_t>(poleIndex.size()));
+    samples.poleId[i] = inserted.first->second;
   }
   int curlong = 0, totlong = 0;
   qh_freeqhull(qh, !qh_ALL);

@@ -19,6 +19,9 @@ struct SurfaceSamples {
   /// that touches it. Samples without one get their own position and radius 0.
   std::vector<Vec3> poleCenter;
   std::vector<double> poleRadius;
+  /// Identifies the pole: samples with the same interior medial sphere share an id; samples
+  /// without a pole keep their own index; poles are numbered from size() on.
+  std::vector<std::uint32_t> poleId;
   std::uint32_t size() const { return static_cast<std::uint32_t>(position.size()); }
 };
 

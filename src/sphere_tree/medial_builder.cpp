@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include "medial_axis.h"
+#include "medial_reduction.h"
 #include "top_down_build.h"
 
 namespace clod::detail {
@@ -27,13 +28,17 @@ double polePull(std::uint32_t level) {
 constexpr double kMaxPieceFraction = 0.2;
 constexpr int kLloydIterations = 12;
 constexpr int kFitDirections = 32;
+constexpr int kScoreDirections = 128;
 constexpr std::uint32_t kClusteringRestarts = 4;
 
 struct Context {
   const TriangleMesh* mesh = nullptr;
   SurfaceSamples samples;
   std::unique_ptr<SampleGrid> grid;
+  std::unique_ptr<VertexTriangles> adjacency;
+  MedialReduction reduction = MedialReduction::kBest;
   std::vector<Vec3> directions;  // unit vectors for the fit estimate
+  std::vector<Vec3> scoreDirections;  // denser, for comparing two splits of a node
   std::uint32_t branching = 8;
   std::uint32_t seed = 1;
 
@@ -41,10 +46,12 @@ struct Context {
     const Vec3 c = piece.centroid();
     if (samples.size() == 0) {
       piece.poleOffset = Vec3::Zero();
+      piece.pole = 0;
       return;
     }
     const std::uint32_t s = grid->nearest(c);
     piece.poleOffset = samples.poleCenter[s] - samples.position[s];
+    piece.pole = samples.poleId[s];
   }
 };
 
@@ -285,6 +292,9 @@ SphereTree buildMedialSphereTree(const TriangleMesh& mesh, const SphereTreeSetti
   const double spacing = std::sqrt(area / std::max<std::uint32_t>(1, ctx.samples.size()));
   ctx.grid = std::make_unique<SampleGrid>(ctx.samples.position, 2.0 * spacing);
   ctx.directions = fibonacciDirections(kFitDirections);
+  ctx.scoreDirections = fibonacciDirections(kScoreDirections);
+  ctx.reduction = settings.medialReduction;
+  if (ctx.reduction != MedialReduction::kKMeans) ctx.adjacency = std::make_unique<VertexTriangles>(mesh);
 
   BuildNode root;
   root.pieces.resize(mesh.triangleCount());
@@ -300,30 +310,60 @@ SphereTree buildMedialSphereTree(const TriangleMesh& mesh, const SphereTreeSetti
     std::vector<SurfacePiece> pieces = parent.pieces;
     refinePieces(ctx, pieces);
     const std::uint32_t k = static_cast<std::uint32_t>(std::min<std::size_t>(ctx.branching, pieces.size()));
-    // k-means from a few seedings; keep the one whose clusters have the smallest spheres.
-    std::vector<Vec3> feature(pieces.size());
-    const double pull = polePull(level);
-    for (std::size_t i = 0; i < pieces.size(); ++i) feature[i] = pieces[i].centroid() + pull * pieces[i].poleOffset;
-    std::vector<std::uint32_t> label;
-    double bestScore = std::numeric_limits<double>::infinity();
-    std::vector<Vec3> scoreScratch;
-    for (std::uint32_t restart = 0; restart < kClusteringRestarts; ++restart) {
-      std::vector<std::uint32_t> candidate =
-          clusterPieces(pieces, feature, k, ctx.seed * 0x9e3779b9u + level * 7919u + index * 31u + restart);
-      const double score = k > 1 ? clusteringScore(pieces, candidate, k, scoreScratch) : 0.0;
-      if (score < bestScore) {
-        bestScore = score;
-        label = std::move(candidate);
+    auto kMeansLabels = [&] {
+      std::vector<std::uint32_t> label;
+      // k-means from a few seedings; keep the one whose clusters have the smallest spheres.
+      std::vector<Vec3> feature(pieces.size());
+      const double pull = polePull(level);
+      for (std::size_t i = 0; i < pieces.size(); ++i) feature[i] = pieces[i].centroid() + pull * pieces[i].poleOffset;
+      double bestScore = std::numeric_limits<double>::infinity();
+      std::vector<Vec3> scoreScratch;
+      for (std::uint32_t restart = 0; restart < kClusteringRestarts; ++restart) {
+        std::vector<std::uint32_t> candidate =
+            clusterPieces(pieces, feature, k, ctx.seed * 0x9e3779b9u + level * 7919u + index * 31u + restart);
+        const double score = k > 1 ? clusteringScore(pieces, candidate, k, scoreScratch) : 0.0;
+        if (score < bestScore) {
+          bestScore = score;
+          label = std::move(candidate);
+        }
+        if (k <= 1) break;
       }
-      if (k <= 1) break;
-    }
-    std::vector<BuildNode> clusters(k);
-    for (std::size_t i = 0; i < pieces.size(); ++i) clusters[label[i]].pieces.push_back(pieces[i]);
-    std::vector<Vec3> corners, scratchPoints, surfacePoints;
-    for (BuildNode& cluster : clusters) {
-      if (cluster.pieces.empty()) continue;
-      cluster.sphere = chooseSphere(ctx, cluster.pieces, corners, scratchPoints, surfacePoints);
-      children.push_back(std::move(cluster));
+      return label;
+    };
+    // Children from labels, each expanded to cover its pieces exactly ("expand"); returns the
+    // estimated fit of the split: largest plus a quarter of the mean overshoot of the children,
+    // at more directions than the centre choice uses (the worst sphere of a level decides
+    // how early a query can trust it, and narrow overhangs hide between 32 directions).
+    auto makeChildren = [&](const std::vector<std::uint32_t>& label, std::vector<BuildNode>& out) {
+      std::uint32_t clusterCount = 0;
+      for (std::uint32_t l : label) clusterCount = std::max(clusterCount, l + 1);
+      std::vector<BuildNode> clusters(clusterCount);
+      for (std::size_t i = 0; i < pieces.size(); ++i) clusters[label[i]].pieces.push_back(pieces[i]);
+      std::vector<Vec3> corners, scratchPoints, surfacePoints;
+      double largest = 0.0, sum = 0.0;
+      for (BuildNode& cluster : clusters) {
+        if (cluster.pieces.empty()) continue;
+        cluster.sphere = chooseSphere(ctx, cluster.pieces, corners, scratchPoints, surfacePoints);
+        const double fit = estimateFit(cluster.sphere, ctx.scoreDirections, surfacePoints);
+        largest = std::max(largest, fit);
+        sum += fit;
+        out.push_back(std::move(cluster));
+      }
+      return largest + 0.25 * (out.empty() ? 0.0 : sum / static_cast<double>(out.size()));
+    };
+    switch (ctx.reduction) {
+      case MedialReduction::kKMeans: makeChildren(kMeansLabels(), children); break;
+      case MedialReduction::kMergeBurst:
+        makeChildren(reduceByMergeAndBurst(*ctx.mesh, *ctx.adjacency, pieces, k), children);
+        break;
+      case MedialReduction::kBest: {
+        std::vector<BuildNode> other;
+        const double mergeBurstFit =
+            makeChildren(reduceByMergeAndBurst(*ctx.mesh, *ctx.adjacency, pieces, k), children);
+        const double kMeansFit = makeChildren(kMeansLabels(), other);
+        if (kMeansFit < mergeBurstFit) children.swap(other);
+        break;
+      }
     }
   };
   return buildTopDown(mesh, std::move(root), settings.depth, settings.branching, split);

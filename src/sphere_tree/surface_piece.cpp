@@ -37,6 +37,7 @@ SurfacePiece clipPiece(const SurfacePiece& piece, int axis, double value, bool k
   SurfacePiece out;
   out.triangle = piece.triangle;
   out.poleOffset = piece.poleOffset;
+  out.pole = piece.pole;
   const int n = piece.cornerCount;
   auto inside = [&](const Vec3& p) { return keepBelow ? p[axis] <= value : p[axis] >= value; };
   bool allInside = true;

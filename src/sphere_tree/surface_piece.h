@@ -24,6 +24,9 @@ struct SurfacePiece {
   /// Medial builder: vector from the piece towards the inner medial pole nearest to it
   /// (unused by the octree builder).
   Vec3 poleOffset = Vec3::Zero();
+  /// Medial builder: id of that inner pole (SurfaceSamples::poleId), so pieces can be grouped
+  /// by the medial sphere they touch (unused by the octree builder).
+  std::uint32_t pole = 0;
 
   std::span<const Vec3> points() const { return {corners.data(), cornerCount}; }
   Vec3 centroid() const;

@@ -1,6 +1,8 @@
 // Structural invariants of built sphere-trees, and settings validation.
 #include <gtest/gtest.h>
 
+#include <tbb/global_control.h>
+
 #include <algorithm>
 #include <numeric>
 
@@ -58,14 +60,25 @@ TEST(SphereTreeBuilder, OutOfRangeSettingsThrowInvalidArgumentNamingTheSetting) 
 TEST(SphereTreeBuilder, TreesHaveConsistentLevelsChildrenParentsAndTriangleListsForAnyBranching) {
   const MeshDistance sphere(makeIcosphere(1.0, 3));
   const MeshDistance cylinder(makeCylinder(0.5, 2.0, 24));
+  struct Builder {
+    SphereTreeMethod method;
+    MedialReduction reduction;
+  };
   for (const MeshDistance* mesh : {&sphere, &cylinder})
-    for (SphereTreeMethod method : {SphereTreeMethod::kOctree, SphereTreeMethod::kMedial})
+    for (const Builder builder : {Builder{SphereTreeMethod::kOctree, MedialReduction::kBest},
+                                  Builder{SphereTreeMethod::kMedial, MedialReduction::kBest},
+                                  Builder{SphereTreeMethod::kMedial, MedialReduction::kMergeBurst}})
       for (std::uint32_t branching : {2u, 4u, 8u, 27u})
         for (std::uint32_t depth : {0u, 1u, 3u}) {
-          SCOPED_TRACE(std::string(sphereTreeMethodName(method)) + " branching " + std::to_string(branching) +
-                       " depth " + std::to_string(depth));
+          // The merge/burst reduction alone at the usual factors only, to keep the runner short
+          // (the default medial builder runs it at every factor).
+          if (builder.reduction == MedialReduction::kMergeBurst && branching != 2 && branching != 8) continue;
+          SCOPED_TRACE(std::string(sphereTreeMethodName(builder.method)) + " reduction " +
+                       std::to_string(static_cast<int>(builder.reduction)) + " branching " +
+                       std::to_string(branching) + " depth " + std::to_string(depth));
           SphereTreeSettings settings;
-          settings.method = method;
+          settings.method = builder.method;
+          settings.medialReduction = builder.reduction;
           settings.branching = branching;
           settings.depth = depth;
           settings.medialSamples = 2000;
@@ -77,21 +90,35 @@ TEST(SphereTreeBuilder, TreesHaveConsistentLevelsChildrenParentsAndTriangleLists
 TEST(SphereTreeBuilder, MedialNodesUseTheFullBranchingFactorWhenThereIsEnoughSurface) {
   // An icosphere of 1280 triangles has far more surface than 8^3 clusters need.
   const MeshDistance sphere(makeIcosphere(1.0, 3));
-  SphereTreeSettings settings;
-  settings.depth = 3;
-  settings.medialSamples = 4000;
-  const SphereTree tree = buildSphereTree(sphere, settings);
-  for (std::uint32_t l = 0; l <= 3; ++l) EXPECT_EQ(tree.levelEnd(l) - tree.levelBegin(l), std::uint32_t(1) << (3 * l));
+  for (MedialReduction reduction : {MedialReduction::kBest, MedialReduction::kMergeBurst, MedialReduction::kKMeans}) {
+    SphereTreeSettings settings;
+    settings.depth = 3;
+    settings.medialSamples = 4000;
+    settings.medialReduction = reduction;
+    const SphereTree tree = buildSphereTree(sphere, settings);
+    for (std::uint32_t l = 0; l <= 3; ++l)
+      EXPECT_EQ(tree.levelEnd(l) - tree.levelBegin(l), std::uint32_t(1) << (3 * l))
+          << "reduction " << static_cast<int>(reduction) << ", level " << l;
+  }
 }
 
 TEST(SphereTreeBuilder, BuildsAreDeterministic) {
   const MeshDistance cylinder(makeCylinder(0.5, 2.0, 24));
-  for (SphereTreeMethod method : {SphereTreeMethod::kOctree, SphereTreeMethod::kMedial}) {
+  for (int builder = 0; builder < 4; ++builder) {
+    SCOPED_TRACE(builder);
     SphereTreeSettings settings;
-    settings.method = method;
     settings.medialSamples = 2000;
+    settings.depth = 3;
+    if (builder == 0) settings.method = SphereTreeMethod::kOctree;
+    if (builder == 2) settings.medialReduction = MedialReduction::kMergeBurst;
+    if (builder == 3) settings.medialReduction = MedialReduction::kKMeans;
     const SphereTree a = buildSphereTree(cylinder, settings);
-    const SphereTree b = buildSphereTree(cylinder, settings);
+    SphereTree b;
+    {
+      // Same tree on one thread as on all of them.
+      const tbb::global_control oneThread(tbb::global_control::max_allowed_parallelism, 1);
+      b = buildSphereTree(cylinder, settings);
+    }
     EXPECT_EQ(a.radius, b.radius);
     EXPECT_EQ(a.centerX, b.centerX);
     EXPECT_EQ(a.triangleList, b.triangleList);
