@@ -396,12 +396,13 @@ double patchSupport(const CollisionBody& body, std::uint32_t sphere, const Vec3&
 // along. Returns false when a patch is not faceted (curved, or too many vertices) or every axis
 // separates: then the lookup rules decide.
 PatchAxis leastOverlapNormal(const CollisionBody& bodyA, std::uint32_t sa, const CollisionBody& bodyB,
-                             std::uint32_t sb, const Pose& xfAFromB, Vec3& best) {
+                             std::uint32_t sb, const Pose& xfAFromB, const Eigen::Matrix3d& rotAFromB, Vec3& best) {
   if (bodyA.spherePatchVertices(sa).empty() || bodyB.spherePatchVertices(sb).empty()) return PatchAxis::kNotFaceted;
   double bestOverlap = std::numeric_limits<double>::infinity();
   bool apart = false;
   auto consider = [&](const Vec3& n) {  // n in A's frame; both n and -n are tried
-    const Vec3 nInB = xfAFromB.rotation.conjugate() * n;
+    if (apart) return;  // one separating axis settles it
+    const Vec3 nInB = rotAFromB.transpose() * n;
     const double shift = n.dot(xfAFromB.translation);
     const double maxB = patchSupport(bodyB, sb, nInB) + shift;
     const double minB = -patchSupport(bodyB, sb, -nInB) + shift;
@@ -422,11 +423,14 @@ PatchAxis leastOverlapNormal(const CollisionBody& bodyA, std::uint32_t sa, const
       best = -n;
     }
   };
-  for (const Vec3f& f : bodyB.sphereFaceNormals(sb)) consider(xfAFromB.rotation * f.cast<double>());
+  for (const Vec3f& f : bodyB.sphereFaceNormals(sb)) consider(rotAFromB * f.cast<double>());
   for (const Vec3f& f : bodyA.sphereFaceNormals(sa)) consider(f.cast<double>());
+  std::array<Vec3, CollisionBody::kMaxSphereEdgeDirections> edgesB;
+  const std::span<const Vec3f> edgeDirsB = bodyB.sphereEdgeDirections(sb);
+  for (std::size_t k = 0; k < edgeDirsB.size(); ++k) edgesB[k] = rotAFromB * edgeDirsB[k].cast<double>();
   for (const Vec3f& ea : bodyA.sphereEdgeDirections(sa)) {
-    for (const Vec3f& eb : bodyB.sphereEdgeDirections(sb)) {
-      const Vec3 axis = ea.cast<double>().cross(xfAFromB.rotation * eb.cast<double>());
+    for (std::size_t k = 0; k < edgeDirsB.size(); ++k) {
+      const Vec3 axis = ea.cast<double>().cross(edgesB[k]);
       const double length = axis.norm();
       if (length < 1e-6) continue;  // parallel edges: their axes are face normals already
       consider(axis / length);
@@ -448,6 +452,7 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
   const SphereTree& tb = bodyB.sphereTree();
   const std::size_t first = out.size();
   apart.clear();
+  const Eigen::Matrix3d rotAFromB = xfAFromB.rotation.toRotationMatrix();
   for (const SpherePair& p : front) {
     bool proven = false;  // the pair's patches are proven apart
     const Vec3 cA = ta.center(p.a);
@@ -479,7 +484,7 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
       // average model is the paper's straw man and stays plain.
       c.normal = differenceNormal(nA, nB, dos.normal);
       const PatchAxis axis = model == ContactModel::kCfm && nB.dot(-nA) < kAgreeCos
-                                 ? leastOverlapNormal(bodyA, p.a, bodyB, p.b, xfAFromB, c.normal)
+                                 ? leastOverlapNormal(bodyA, p.a, bodyB, p.b, xfAFromB, rotAFromB, c.normal)
                                  : PatchAxis::kChosen;
       proven = axis == PatchAxis::kApart;
       if (axis != PatchAxis::kChosen) {

@@ -19,8 +19,10 @@ inline bool sanitizerRun() {
 
 /// A body with sphere-tree (medial, 8-ary, `depth` levels below the root), closest feature map
 /// (16 root stacks: finer than the paper's 10 so the sphere tests' tolerances stay small) and
-/// contact tree (errorRel 2e-3).
-inline CollisionBody makeTestBody(const TriangleMesh& mesh, std::uint32_t depth, bool withContactTree = true) {
+/// contact tree (errorRel 2e-3). The map and the tree are the expensive parts (most of the
+/// suite's time under the sanitizers): tests that do not use them leave them out.
+inline CollisionBody makeTestBody(const TriangleMesh& mesh, std::uint32_t depth, bool withContactTree = true,
+                                  bool withClosestFeatureMap = true) {
   BakeSettings settings;
   settings.sphereTree.depth = depth;
   settings.sphereTree.medialSamples = 2000;
@@ -30,9 +32,11 @@ inline CollisionBody makeTestBody(const TriangleMesh& mesh, std::uint32_t depth,
   const BakeResult baked = bakeMesh(mesh, settings);
   CollisionBody body = CollisionBody::fromBake(baked.contents);
   const MeshDistance distance(mesh);
-  ClosestFeatureMapSettings cfm;
-  cfm.rootStacks = 16;
-  body.setClosestFeatureMap(buildClosestFeatureMap(distance, body.sphereTree(), cfm));
+  if (withClosestFeatureMap) {
+    ClosestFeatureMapSettings cfm;
+    cfm.rootStacks = 16;
+    body.setClosestFeatureMap(buildClosestFeatureMap(distance, body.sphereTree(), cfm));
+  }
   if (withContactTree) {
     ContactTreeSettings ct;
     ct.errorRel = 2e-3;

@@ -407,7 +407,7 @@ TEST(NarrowPhaseCoherence, CachedQueryEqualsColdQueryAtUnlimitedBudget) {
 }
 
 TEST(NarrowPhaseModels, MissingSectionsAndBadSettingsThrow) {
-  const CollisionBody plain = test::makeTestBody(makeBox(Vec3::Constant(1.0)), 1, false);
+  const CollisionBody plain = test::makeTestBody(makeBox(Vec3::Constant(1.0)), 1, false, false);
   CollisionBody bare(plain.mesh(), plain.sphereTree());
   Pose poseA;
   poseA.translation = Vec3(0, 0, 1.9);
