@@ -42,7 +42,7 @@ struct BodyLayerOptions {
   /// Cap on all per-body floats together (sphere, sample and cell numbers): bodies, in scene
   /// order, get their layers while the running total stays within it; later bodies get none
   /// (their entries keep name and node). 0 = no cap.
-  std::uint64_t maxBodyLayerFloats = 4'000'000;
+  std::uint64_t maxBodyLayerFloats = 1'000'000;
 };
 
 class SimulationRecorder {
