@@ -9,19 +9,22 @@
 //     sample nearest to it, so the node starts with one sphere per distinct medial sphere it
 //     touches ("many spheres"). A sphere is responsible for the surface points of its pieces.
 //     Deep in the tree a node touches only a few medial spheres (the medial axis is sampled once,
-//     for the whole mesh); when fewer than 4 * branching exist, every piece starts as its own
+//     for the whole mesh); when fewer than 2 * branching exist, every piece starts as its own
 //     sphere instead (deviation: Bradshaw samples each region's medial axis anew, adaptively).
 //  2. Merge: two neighbouring spheres (their surface pieces share a mesh vertex) are replaced by
 //     one sphere that covers both spheres' surface points (not the spheres themselves). The pair
-//     whose merged sphere adds the least fit error, fit(merged) - max(fit(a), fit(b)), goes
-//     first. Pairs sit in a priority queue; a merge re-evaluates the new sphere's pairs, and
-//     entries of spheres changed since they were queued are dropped (lazy updates).
+//     whose merged sphere has the least estimated fit goes first (the absolute fit, not the
+//     added fit(merged) - max(fit(a), fit(b)): on the shared meshes the added error let one
+//     sphere absorb its neighbours at little added cost and left a level's worst sphere twice
+//     as loose). Pairs sit in a priority queue; a pair whose spheres changed since it was queued
+//     is re-evaluated when it comes up and queued again (lazy updates; the old estimate is
+//     nearly always a lower bound, as merging only grows spheres).
 //  3. Burst: a sphere is removed and each of its pieces handed to the neighbour whose sphere it
-//     sticks out of least; those neighbours grow. Its cost is the largest fit increase among the
-//     neighbours. Bursts and merges share the queue, so a burst happens only when it costs less
+//     sticks out of least; those neighbours grow. Its cost is the largest estimated fit among the
+//     grown neighbours. Bursts and merges share the queue, so a burst happens only when it costs less
 //     than every merge; a burst whose neighbourhood changed is re-evaluated when it comes up.
-//  4. Repeat 2-3 until `branching` spheres remain. Neighbourless leftovers (separate surface
-//     components) are linked to their nearest spheres.
+//  4. Repeat 2-3 until `branching` spheres remain. Separate surface components are linked to
+//     their two nearest spheres at the start (and any leftovers when the queue runs dry).
 //  5. Expand (done by the caller): each remaining sphere is re-fitted to all of its pieces
 //     exactly, the centre chosen to minimise the estimated overshoot, so coverage is exact.
 // During 2-3 a sphere is summarised by a bounded point set: its extreme surface points in 14
@@ -32,7 +35,7 @@
 // poles) and their midpoint. Each evaluation is then O(1), and reducing n spheres costs
 // O(n * degree * log n).
 // Deviations from the paper, beyond step 1: the fit that steers merge and burst is estimated at
-// 24 directions against the summary points (Bradshaw evaluates against the full sample set), the
+// 16 directions against the summary points (Bradshaw evaluates against the full sample set), the
 // "neighbour" relation comes from mesh adjacency rather than from the medial axis' own
 // connectivity, and a sphere's centre is searched on a segment instead of optimised freely.
 
