@@ -42,7 +42,9 @@ void ContactTree::buildLookupGrid() {
   gridNode.clear();
   gridCorners.clear();
   std::uint32_t d = 0;
-  while (d < 5 && d + 1 < depthCount() && (std::uint64_t{1} << (3 * (d + 1))) <= nodeCount() / 8) ++d;
+  // Depth 5 (272 KiB) measured 13-20 % slower than no grid: it is colder in the cache than
+  // the top tree levels it replaces. Depth 3 (4.9 KiB) stays L1-resident.
+  while (d < 3 && d + 1 < depthCount() && (std::uint64_t{1} << (3 * (d + 1))) <= nodeCount() / 8) ++d;
   if (d == 0) return;
   gridDepth = d;
   const std::uint32_t n = 1u << d, m = n + 1;
