@@ -23,10 +23,6 @@ constexpr double kTravelFraction = 0.25;
 constexpr double kMaxCorrectionRel = 0.02;
 // A previous contact passes its impulse on only to a new contact whose normal is within ~18 deg.
 constexpr double kWarmStartNormalCos = 0.95;
-// Finer contacts are kept over a coarser query answer for at most this many substeps and while
-// the bodies have moved less than this fraction of the smaller diagonal relative to each other.
-constexpr std::uint32_t kMaxKeptSubsteps = 30;
-constexpr double kKeptTravelRel = 0.02;
 
 bool finite(const Vec3& v) { return v.allFinite(); }
 
@@ -84,9 +80,6 @@ struct PairState {
   double priority = 0.0;
   bool seen = false;         // in this substep's broad phase
   bool fresh = false;        // queried this substep (else: skipped, contacts kept)
-  std::uint32_t level = 0;   // QueryResult::maxLevel of the query the contacts came from
-  std::uint32_t keptSubsteps = 0;  // substeps the contacts were kept over a coarser answer
-  double keptTravel = 0.0;   // relative travel of the bodies since the contacts were made
 };
 
 std::uint64_t pairKey(BodyId a, BodyId b) { return (std::uint64_t(a) << 32) | b; }
@@ -262,24 +255,6 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance) {
     pr.skipped = false;
     if (!result.finished) ++report.pairsInterrupted;
     p->stale = 0;
-    // Graceful degradation must not mean regression: when an interrupted query reaches a
-    // coarser level than the contacts the pair already has (its coherence front was lost, or
-    // its share was tiny), the finer contacts are kept while the two bodies have hardly moved
-    // relative to each other since they were made. A root-level D&O contact of a big floor is
-    // nearly horizontal near the floor's edge and lets a resting body slide through the floor
-    // (docs/dynamics.md, the 200-body bin).
-    const double diagMin = std::min(a.desc.shape->diagonal(), bb.desc.shape->diagonal());
-    p->keptTravel += ((a.v - bb.v).norm() + a.w.norm() * 0.5 * a.localBox.diagonal() +
-                      bb.w.norm() * 0.5 * bb.localBox.diagonal()) * h;
-    if (!result.finished && !result.contacts.empty() && !p->contacts.empty() && result.maxLevel < p->level &&
-        p->keptSubsteps < kMaxKeptSubsteps && p->keptTravel < kKeptTravelRel * diagMin) {
-      ++p->keptSubsteps;
-      p->fresh = false;
-      continue;
-    }
-    p->level = result.maxLevel;
-    p->keptSubsteps = 0;
-    p->keptTravel = 0.0;
     p->fresh = true;
     p->previous.swap(p->contacts);
     p->contacts.clear();
