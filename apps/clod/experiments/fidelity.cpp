@@ -51,7 +51,7 @@ constexpr double kAngularSpeedMax = 1.0;        // rad/s, moving body's spin mag
 constexpr double kStartGapRel = 0.15;           // start with the bounding spheres this far apart (diagonals)
 constexpr double kRestitution = 0.5;
 constexpr double kFriction = 0.2;
-constexpr long kDefaultTrials = 12;
+constexpr long kDefaultTrials = 40;
 constexpr double kGapToleranceRel = 1e-3;      // surfaceGap accuracy: 1/20 of the gap's 50 % point
 
 const ContactModel kModels[] = {ContactModel::kDos, ContactModel::kAverage, ContactModel::kCfm, ContactModel::kContactTree};
