@@ -153,13 +153,19 @@ int runSimulate(const SimulateOptions& o) {
                             {"shapes_from_cache", build.shapesFromCache},
                             {"bake_seconds", build.bakeSeconds},
                             {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
+  // Encode the viewer files before writing anything, so an export error leaves no new files.
+  std::string glb, layersJson;
+  if (recorder) {
+    glb = encodeGlb(recorder->gltfScene());
+    layersJson = encodeDebugLayers(recorder->debugLayers(layerOptions));
+  }
   writeFileAtomically(out / "trajectory.csv", traj.str());
   writeFileAtomically(out / "contacts.csv", contacts.str());
   writeFileAtomically(out / "summary.json", summary.dump(2) + "\n");
   std::cout << "simulated " << scene.steps << " steps of " << world.bodyCount() << " bodies -> " << o.outDir << "\n";
   if (recorder) {
-    saveGlb(out / "scene.glb", recorder->gltfScene());
-    writeFileAtomically(out / "layers.json", encodeDebugLayers(recorder->debugLayers(layerOptions)));
+    writeFileAtomically(out / "scene.glb", glb);
+    writeFileAtomically(out / "layers.json", layersJson);
     std::cout << "glTF: scene.glb + layers.json, " << recorder->frameCount() << " frames ("
               << (recorder->frameStride() == 1 ? std::string("every step")
                                                : "every " + std::to_string(recorder->frameStride()) +
@@ -177,9 +183,11 @@ const CommandRegistration kRegistration("simulate", [](CLI::App& app) {
   sub->add_option("--contact-model", options->model, "Override: dos, average, cfm, contact-tree, exact");
   sub->add_option("--budget", options->budget, "Override: tests per frame (0 = unlimited)");
   sub->add_flag("--progress", options->progress, "Always show the progress bar on stderr");
-  sub->add_flag("--gltf", options->gltf, "Also write scene.glb (meshes + animation) and layers.json (debug layers)");
+  CLI::Option* gltf =
+      sub->add_flag("--gltf", options->gltf, "Also write scene.glb (meshes + animation) and layers.json (debug layers)");
   sub->add_option("--gltf-layers", options->gltfLayers,
-                  "Per-body layers in layers.json: comma list of spheres, cfm, ctree, or none (default: all three)");
+                  "Per-body layers in layers.json: comma list of spheres, cfm, ctree, or none (default: all three)")
+      ->needs(gltf);
   return [options] { return runSimulate(*options); };
 });
 

@@ -198,6 +198,9 @@ TEST_F(CliExport, SimulateGltfLayersNoneKeepsFramesOnlyAndBadLayerNamesAreUsageE
   EXPECT_NE(run.err.find("bogus"), std::string::npos) << run.err;
   EXPECT_FALSE(fs::exists(out2 / "scene.glb"));
   EXPECT_FALSE(fs::exists(out2 / "summary.json"));
+  // --gltf-layers without --gltf is a usage error, not silently ignored.
+  EXPECT_EQ(runCli("simulate " + quoted(dir_ / "scene.json") + " -o " + quoted(out2) + " --gltf-layers none").exitCode, 2);
+  EXPECT_FALSE(fs::exists(out2 / "summary.json"));
 }
 
 // The vertices of an OBJ file ('v x y z' lines), read here independently of the library.
