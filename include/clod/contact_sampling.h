@@ -66,8 +66,11 @@ struct ContactSamplingSettings {
   /// normalConflictDeg), and both fields show an edge around the sample (their gradients,
   /// probed at 7 points within twice the larger cell size, span a plane), the normal is taken
   /// perpendicular to both edges (docs/contact-tree.md); this takes precedence over the face
-  /// rule of normalConflictDeg. The gradient of one field alone is "rounded" there and tilts
-  /// up to 45 degrees toward one of the faces. Costs 16 extra field queries per such sample.
+  /// rule of normalConflictDeg. Edges within 15 degrees of parallel have no common
+  /// perpendicular (and a face overhanging an edge, its own parallel edge within the probe
+  /// radius, looks the same), so those samples are left to the face rule. The gradient of one
+  /// field alone is "rounded" at crossing edges and tilts up to 45 degrees toward one of the
+  /// faces. Costs 16 extra field queries per such sample.
   bool edgeEdgeNormals = true;
   /// Depth limit for field queries and traversal (kContactTreeLeafDepth: full resolution).
   /// A time-budgeted caller passes a smaller value to stop higher in both trees.

@@ -63,25 +63,25 @@ bool edgeDirection(const ContactTree& tree, const Vec3& p, double rho, std::uint
 
 // Normal out of O toward S at world point pWorld where both bodies show an edge: perpendicular
 // to both edges (the common normal of two crossing segments), oriented along gO - gS (the
-// fields' world gradients: out of O, and into S). Parallel edges leave a whole fan of valid
-// normals; then the bisector gO - gS is used. False when either field shows no clean edge.
+// fields' world gradients: out of O, and into S). False when either field shows no clean edge
+// or the edges are within 15 degrees of parallel. Parallel edges have no common perpendicular,
+// and the probes cannot tell a touching parallel pair from a face overhanging the other body's
+// edge with its own parallel edge a few cells away (both fields "show an edge" within the probe
+// radius): there the bisector of the two gradients tilted the face contact's normal by up to
+// 26 degrees (commit 44f3c53 broke NarrowPhaseCubeOnCube that way), so the existing rules
+// (face wins, else the field gradient) decide instead.
 bool edgeEdgeNormal(const ContactTree& treeS, const Vec3& pS, const Pose& xfWorldFromS, double rhoS,
                     const ContactTree& treeO, const Vec3& pO, const Pose& xfWorldFromO, double rhoO,
                     std::uint32_t maxDepth, Vec3& normal) {
   Vec3 edgeS, edgeO;
   if (!edgeDirection(treeS, pS, rhoS, maxDepth, edgeS) || !edgeDirection(treeO, pO, rhoO, maxDepth, edgeO)) return false;
-  const Vec3 gO = xfWorldFromO.rotation * treeO.sample(pO, maxDepth).gradient.normalized();
-  const Vec3 gS = xfWorldFromS.rotation * treeS.sample(pS, maxDepth).gradient.normalized();
-  const Vec3 bisector = gO - gS;
   const Vec3 cross = (xfWorldFromS.rotation * edgeS).cross(xfWorldFromO.rotation * edgeO);
   constexpr double kParallelSin = 0.26;  // edges within 15 degrees count as parallel
-  if (cross.norm() > kParallelSin) {
-    normal = cross.normalized();
-    if (normal.dot(bisector) < 0.0) normal = -normal;
-    return true;
-  }
-  if (!(bisector.norm() > 1e-9)) return false;
-  normal = bisector.normalized();
+  if (!(cross.norm() > kParallelSin)) return false;
+  const Vec3 gO = xfWorldFromO.rotation * treeO.sample(pO, maxDepth).gradient.normalized();
+  const Vec3 gS = xfWorldFromS.rotation * treeS.sample(pS, maxDepth).gradient.normalized();
+  normal = cross.normalized();
+  if (normal.dot(gO - gS) < 0.0) normal = -normal;
   return true;
 }
 

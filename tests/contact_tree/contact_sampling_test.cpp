@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <tuple>
 
 #include "clod/contact_sampling.h"
@@ -171,6 +173,33 @@ void expectEdgeEdgeNormalsVertical(double yaw) {
 TEST(ContactSampling, CrossedEdgesGetTheCommonPerpendicularAsNormal) { expectEdgeEdgeNormalsVertical(0.0); }
 
 TEST(ContactSampling, SkewCrossedEdgesGetTheCommonPerpendicularAsNormal) { expectEdgeEdgeNormalsVertical(kPi / 6.0); }
+
+// A's flat bottom face overhangs B's top edge x = 1, with A's own bottom edge parallel to it and
+// 0.02..0.3 past it: only B has an edge at the samples along there, so the contact is
+// face-on-edge and its normal is A's face normal, +z (analytic). Both edges lie within the
+// edge-edge rule's probe radius, which must not take them for a touching edge pair (it did, and
+// tilted these normals by 17..18 degrees). Thinning is turned off so that every raw contact is
+// checked (it would otherwise hide tilted ones inside the face's patch). Excluded: contacts
+// within 0.3 of the two points (1, +-0.5) where A's edges y = +-0.5 really cross B's edge --
+// the rule's own case, tested above; 0.3 bounds its probe radius there (twice the leaf cell).
+TEST(ContactSampling, FaceOverhangingAParallelEdgeKeepsTheFaceNormal) {
+  ContactSamplingSettings settings;
+  settings.maxContactsPerPatch = std::numeric_limits<std::uint32_t>::max();
+  for (double overhang : {0.02, 0.05, 0.1, 0.3}) {
+    const Pose poseA = restingPose(0.5 + overhang, 0.0, 0.0, 2e-3);
+    std::vector<ContactPoint> contacts;
+    findContacts(boxes().treeA, poseA, boxes().treeB, Pose{}, settings, contacts);
+    int checked = 0;
+    for (const ContactPoint& c : contacts) {
+      if ((c.point.head<2>() - Eigen::Vector2d(1.0, std::copysign(0.5, c.point.y()))).norm() < 0.3) continue;
+      ++checked;
+      // 1 degree, as for resting faces above.
+      EXPECT_GT(c.normal.z(), std::cos(kPi / 180.0))
+          << "overhang " << overhang << " normal " << c.normal.transpose() << " at " << c.point.transpose();
+    }
+    EXPECT_GT(checked, 20) << overhang;  // the face contacts along the overhung edge are there
+  }
+}
 
 TEST(ContactSampling, OneFieldGradientAloneTiltsCrossedEdgeNormals) {
   // Shows what the edge-edge rule repairs (and that the test above can fail): with it off,
