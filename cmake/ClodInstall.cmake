@@ -14,6 +14,8 @@ find_dependency(Eigen3 3.4 NO_MODULE)
 find_dependency(TBB)
 find_dependency(assimp)
 find_dependency(Qhull)
+find_dependency(nlohmann_json)
+find_dependency(TinyGLTF)
 include("${CMAKE_CURRENT_LIST_DIR}/clodTargets.cmake")
 ]=])
 configure_package_config_file(${PROJECT_BINARY_DIR}/clodConfig.cmake.in

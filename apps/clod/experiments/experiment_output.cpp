@@ -37,9 +37,12 @@ std::string gnuplotString(const std::string& text) {
 
 std::string gnuplotScript(const Plot& plot) {
   std::ostringstream gp;
-  gp << "# Drawn by `clod experiment`; rerun with: gnuplot " << plot.file << ".gp\n"
+  // `clod experiment` passes outfile=<name>.png.tmp (renamed into place on success); by hand,
+  // `gnuplot <name>.gp` in the output folder redraws <name>.png directly.
+  gp << "# Drawn by `clod experiment`; redraw with: gnuplot " << plot.file << ".gp\n"
+     << "if (!exists(\"outfile\")) outfile = " << gnuplotString(plot.file + ".png") << "\n"
      << "set terminal pngcairo noenhanced size 960,600 font \"sans,10\"\n"
-     << "set output " << gnuplotString(plot.file + ".png.tmp") << "\n"
+     << "set output outfile\n"
      << "set datafile separator \",\"\n"
      << "set title " << gnuplotString(plot.title) << "\n"
      << "set xlabel " << gnuplotString(plot.xLabel) << "\n"
@@ -62,7 +65,7 @@ void drawPlot(const std::filesystem::path& dir, const Plot& plot) {
   if (plot.series.empty()) throw Error(ErrorCode::kInvalidArgument, "plot '" + plot.file + "' has no series");
   writeFileAtomically(dir / (plot.file + ".gp"), gnuplotScript(plot));
   const std::filesystem::path log = dir / (plot.file + ".gp.log.tmp");
-  const std::string command = "cd " + shellQuoted(dir.string()) + " && gnuplot " + shellQuoted(plot.file + ".gp") +
+  const std::string command = "cd " + shellQuoted(dir.string()) + " && gnuplot -e " + shellQuoted("outfile=\"" + plot.file + ".png.tmp\"") + " " + shellQuoted(plot.file + ".gp") +
                               " > " + shellQuoted(log.filename().string()) + " 2>&1";
   const int status = std::system(command.c_str());
   std::string messages;
