@@ -152,7 +152,11 @@ TEST_F(CliNormals, FaceCentreContactsGetFaceNormalsAndTheNearestContainingSphere
             EXPECT_LE(angleDeg(n, faceNormals[f]), 1.0) << "root, face " << f;
           }
         }
-        if (std::string(model) == "dos") {
+        // D&O's normal is the direction from the sphere's centre to the point: undefined when a
+        // sphere is centred on the face centre itself (the medial builder can place one there on
+        // this box), so only points clear of the centre by more than rounding (1e-9 of the box's
+        // 3.7 m diagonal) are checked.
+        if (std::string(model) == "dos" && chosen > 1e-9 * std::sqrt(14.0)) {
           const auto& c = list[sphere - levelBegin]["center"];
           const std::array<double, 3> d = {(point[f][0] - c[0].get<double>()) / chosen, (point[f][1] - c[1].get<double>()) / chosen,
                                            (point[f][2] - c[2].get<double>()) / chosen};
