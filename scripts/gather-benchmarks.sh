@@ -17,8 +17,9 @@ pages=(proximity sphere_tree bake sampling cfm contact_tree sdfbake narrowphase 
     [ -f "$f" ] || continue
     echo "---"
     echo
-    # Demote headings one level so each page becomes a section.
-    sed -e 's/^#/##/' "$f"
+    # Demote headings one level so each page becomes a section; relative image links are
+    # rewritten to point into docs/benchmarks/ from the repository root.
+    sed -e 's/^#/##/' -e 's/](\([A-Za-z0-9_.-]*\.\(png\|svg\)\))/](docs\/benchmarks\/\1)/g' "$f"
     echo
   done
 } > BENCHMARKS.md.tmp
