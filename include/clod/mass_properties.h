@@ -40,4 +40,9 @@ struct MassProperties {
 /// Complexity: O(T log T) for the closedness check (edge sort) plus O(T) for the integrals.
 MassProperties computeMassProperties(const TriangleMesh& mesh, double density = 1.0);
 
+/// As computeMassProperties for a closed mesh; an open mesh (no enclosed volume, e.g. a scan
+/// with holes such as bunny-1500) gets those of the solid box of its bounds instead, so a body
+/// made from it still has a plausible mass and inertia. Other errors propagate.
+MassProperties computeMassPropertiesOrBoundingBox(const TriangleMesh& mesh, double density = 1.0);
+
 }  // namespace clod

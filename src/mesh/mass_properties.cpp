@@ -66,4 +66,23 @@ MassProperties computeMassProperties(const TriangleMesh& mesh, double density) {
   return result;
 }
 
+MassProperties computeMassPropertiesOrBoundingBox(const TriangleMesh& mesh, double density) {
+  try {
+    return computeMassProperties(mesh, density);
+  } catch (const Error& e) {
+    if (e.code() != ErrorCode::kUnsupportedMesh) throw;
+  }
+  const Aabb box = mesh.bounds();
+  const Vec3 e = box.extent();
+  MassProperties mp;
+  mp.volume = e.x() * e.y() * e.z();
+  mp.mass = density * mp.volume;
+  mp.centerOfMass = box.center();
+  mp.inertia = Mat3::Zero();  // solid box about its centre: m/12 (b^2 + c^2) per axis
+  mp.inertia(0, 0) = mp.mass / 12.0 * (e.y() * e.y() + e.z() * e.z());
+  mp.inertia(1, 1) = mp.mass / 12.0 * (e.x() * e.x() + e.z() * e.z());
+  mp.inertia(2, 2) = mp.mass / 12.0 * (e.x() * e.x() + e.y() * e.y());
+  return mp;
+}
+
 }  // namespace clod

@@ -139,28 +139,6 @@ SceneBody parseBody(const Reader& r, const Json& j, const std::string& path, con
   return b;
 }
 
-// Mass properties at density 1. An open mesh (bunny-1500 has 71 boundary edges) encloses no
-// volume, so the solid box of its bounds stands in for it: the body still gets a plausible
-// mass and inertia instead of being rejected.
-MassProperties massPropertiesOf(const TriangleMesh& mesh) {
-  try {
-    return computeMassProperties(mesh, 1.0);
-  } catch (const Error& e) {
-    if (e.code() != ErrorCode::kUnsupportedMesh) throw;
-  }
-  const Aabb box = mesh.bounds();
-  const Vec3 e = box.extent();
-  MassProperties mp;
-  mp.volume = e.x() * e.y() * e.z();
-  mp.mass = mp.volume;
-  mp.centerOfMass = box.center();
-  mp.inertia = Mat3::Zero();
-  mp.inertia(0, 0) = mp.mass / 12.0 * (e.y() * e.y() + e.z() * e.z());
-  mp.inertia(1, 1) = mp.mass / 12.0 * (e.x() * e.x() + e.z() * e.z());
-  mp.inertia(2, 2) = mp.mass / 12.0 * (e.x() * e.x() + e.y() * e.y());
-  return mp;
-}
-
 }  // namespace
 
 SceneDescription parseScene(std::string_view text, const std::filesystem::path& baseDir, const std::string& fileName) {
@@ -279,7 +257,7 @@ World buildWorld(const SceneDescription& scene, const std::filesystem::path& cac
         ct.maxDepth = sb.bake.contactTreeDepth;
         body->setContactTree(buildContactTree(MeshDistance(mesh), ct));
       }
-      MassProperties mp = massPropertiesOf(mesh);
+      MassProperties mp = computeMassPropertiesOrBoundingBox(mesh);
       rep.bakeSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       found = shapes.emplace(key, std::make_pair(std::shared_ptr<const CollisionBody>(body), mp)).first;
     }

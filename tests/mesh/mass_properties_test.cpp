@@ -157,6 +157,23 @@ TEST(MassProperties, OpenMeshThrowsUnsupportedMesh) {
   EXPECT_EQ(thrownCode(box), ErrorCode::kUnsupportedMesh);
 }
 
+TEST(MassProperties, OpenMeshFallsBackToTheSolidBoxOfItsBounds) {
+  // A 2 x 4 x 6 box with one triangle missing is open; the fallback is the analytic solid box of
+  // the same bounds at density 2 (mass 96), centred at the translation.
+  TriangleMesh box = makeBox(Vec3(1, 2, 3));
+  box.triangles.pop_back();
+  for (Vec3& v : box.vertices) v += Vec3(5, -1, 2);
+  const MassProperties mp = computeMassPropertiesOrBoundingBox(box, 2.0);
+  EXPECT_NEAR(mp.volume, 48.0, kRoundingRel * 48.0);
+  EXPECT_NEAR(mp.mass, 96.0, kRoundingRel * 96.0);
+  EXPECT_LE((mp.centerOfMass - Vec3(5, -1, 2)).norm(), kRoundingRel * 10.0);
+  EXPECT_LE((mp.inertia - boxInertia(Vec3(1, 2, 3), 96.0)).norm(), kRoundingRel * 1e3);
+  // A closed mesh keeps its exact properties, and other errors still propagate.
+  const MassProperties closed = computeMassPropertiesOrBoundingBox(makeBox(Vec3(1, 2, 3)));
+  EXPECT_NEAR(closed.volume, 48.0, kRoundingRel * 48.0);
+  EXPECT_THROW(computeMassPropertiesOrBoundingBox(TriangleMesh{}), Error);
+}
+
 TEST(MassProperties, InconsistentOrientationThrowsUnsupportedMesh) {
   TriangleMesh box = makeBox(Vec3(1, 1, 1));
   std::swap(box.triangles[0][1], box.triangles[0][2]);

@@ -67,25 +67,6 @@ struct Shape {
   std::uint32_t rejected = 0;
 };
 
-// Mass properties at density 1; an open mesh (bunny-1500) gets those of its bounding box, as
-// the scene loader does (docs/dynamics.md).
-MassProperties massOf(const TriangleMesh& mesh) {
-  try {
-    return computeMassProperties(mesh, 1.0);
-  } catch (const Error& e) {
-    if (e.code() != ErrorCode::kUnsupportedMesh) throw;
-  }
-  const Vec3 e = mesh.bounds().extent();
-  MassProperties mp;
-  mp.volume = mp.mass = e.x() * e.y() * e.z();
-  mp.centerOfMass = mesh.bounds().center();
-  mp.inertia = Mat3::Zero();
-  mp.inertia(0, 0) = mp.mass / 12.0 * (e.y() * e.y() + e.z() * e.z());
-  mp.inertia(1, 1) = mp.mass / 12.0 * (e.x() * e.x() + e.z() * e.z());
-  mp.inertia(2, 2) = mp.mass / 12.0 * (e.x() * e.x() + e.y() * e.y());
-  return mp;
-}
-
 // The bunny is scaled to the cube's diagonal (sqrt 3) so both shapes share every setting.
 Shape makeShape(const std::string& name, const ExperimentOptions& options) {
   TriangleMesh mesh;
@@ -106,7 +87,7 @@ Shape makeShape(const std::string& name, const ExperimentOptions& options) {
   s.name = name;
   s.body = std::make_shared<const CollisionBody>(CollisionBody::fromBake(baked.contents));
   s.bakeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  s.mass = massOf(mesh);
+  s.mass = computeMassPropertiesOrBoundingBox(mesh);
   for (const Vec3& v : mesh.vertices) s.radius = std::max(s.radius, (v - s.mass.centerOfMass).norm());
   s.diagonal = mesh.bounds().diagonal();
   s.distance = std::make_unique<MeshDistance>(std::move(mesh));

@@ -40,25 +40,6 @@ struct Body {
   double diagonal = 0.0;
 };
 
-// Mass properties at density 1; an open mesh (bunny-1500) gets those of its bounding box, as
-// the scene loader does (docs/dynamics.md).
-MassProperties massOf(const TriangleMesh& mesh) {
-  try {
-    return computeMassProperties(mesh, 1.0);
-  } catch (const Error& e) {
-    if (e.code() != ErrorCode::kUnsupportedMesh) throw;
-  }
-  const Vec3 e = mesh.bounds().extent();
-  MassProperties mp;
-  mp.volume = mp.mass = e.x() * e.y() * e.z();
-  mp.centerOfMass = mesh.bounds().center();
-  mp.inertia = Mat3::Zero();
-  mp.inertia(0, 0) = mp.mass / 12.0 * (e.y() * e.y() + e.z() * e.z());
-  mp.inertia(1, 1) = mp.mass / 12.0 * (e.x() * e.x() + e.z() * e.z());
-  mp.inertia(2, 2) = mp.mass / 12.0 * (e.x() * e.x() + e.y() * e.y());
-  return mp;
-}
-
 Body bakeBody(const TriangleMesh& mesh) {
   BakeSettings settings;
   settings.sphereTree.depth = 3;  // four levels, as in the paper's experiments
@@ -66,7 +47,7 @@ Body bakeBody(const TriangleMesh& mesh) {
   settings.buildContactTree = false;  // dos, cfm and exact only
   Body b;
   b.shape = std::make_shared<const CollisionBody>(CollisionBody::fromBake(bakeMesh(mesh, settings).contents));
-  b.mass = massOf(mesh);
+  b.mass = computeMassPropertiesOrBoundingBox(mesh);
   b.diagonal = mesh.bounds().diagonal();
   return b;
 }
