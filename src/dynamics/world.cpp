@@ -23,6 +23,10 @@ constexpr double kTravelFraction = 0.25;
 constexpr double kMaxCorrectionRel = 0.02;
 // A previous contact passes its impulse on only to a new contact whose normal is within ~18 deg.
 constexpr double kWarmStartNormalCos = 0.95;
+// A persistent contact keeps its body-anchored points while the two anchors have slid apart by
+// less than this fraction of the smaller body's diagonal (tangentially) and have not opened by
+// more than it (Bullet's contact breaking threshold plays the same role: 2 cm for unit bodies).
+constexpr double kAnchorDriftRel = 0.01;
 
 bool finite(const Vec3& v) { return v.allFinite(); }
 
@@ -60,9 +64,14 @@ struct Body {
   }
 };
 
-// One contact constraint; accumulated impulses persist for warm starting.
+// One contact constraint; accumulated impulses persist for warm starting. The contact is
+// anchored in both bodies (anchorA, anchorB: body-frame offsets from the centre of mass), so its
+// separation follows the bodies' motion point by point (see persistContacts below).
 struct SolverContact {
   Contact c;
+  Vec3 anchorA = Vec3::Zero(), anchorB = Vec3::Zero();
+  double separation = 0;  // (anchor A - anchor B) . normal in the world: < 0 penetrating
+  double speculative = 0; // max(separation, 0) / h: approach speed the velocity solve allows
   Vec3 rA = Vec3::Zero(), rB = Vec3::Zero(), t1 = Vec3::UnitX(), t2 = Vec3::UnitY();
   double massN = 0, massT1 = 0, massT2 = 0;
   double restitution = 0; // coefficient if this contact bounces this substep, else 0
@@ -120,11 +129,13 @@ struct World::Impl {
     if (!(s.restitutionThreshold >= 0.0 && std::isfinite(s.restitutionThreshold))) bad("restitutionThreshold must be >= 0");
     if (!(s.convergenceRel >= 0.0)) bad("convergenceRel must be >= 0");
     if (s.maxSubsteps == 0) bad("maxSubsteps must be >= 1");
+    if (s.minSubsteps == 0 || s.minSubsteps > s.maxSubsteps) bad("minSubsteps must be in [1, maxSubsteps]");
   }
 
   // limited == false: unlimited budget; else at most `allowance` tests this substep (0: none).
   void substep(double h, bool limited, std::uint64_t allowance);
   void solve(double h);
+  void persistContacts(PairState& p, const Body& a, const Body& b, double diag);
   double kineticEnergyOfDynamicBodies() const;
   void integrate(double h);
   void checkFinite() const;
@@ -272,22 +283,29 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance) {
   solveOrder.assign(order.begin(), order.end());
   std::sort(solveOrder.begin(), solveOrder.end(), [](const auto& l, const auto& r) { return l.second < r.second; });
 
-  // Prepare constraints (points are world-frame; skipped pairs keep their last ones). Everything
-  // that depends on the velocities is read before any warm-start impulse is applied, so it does
-  // not depend on the pair order.
+  // Prepare constraints. Everything that depends on the velocities is read before any
+  // warm-start impulse is applied, so it does not depend on the pair order.
   for (auto& [p, ids] : solveOrder) {
     Body& a = bodies[ids[0]];
     Body& b = bodies[ids[1]];
     const double restitution = std::max(a.desc.restitution, b.desc.restitution);
     const double diag = std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal());
-    const double matchDistance = 0.05 * diag;
+    if (p->fresh) persistContacts(*p, a, b, diag);
     double maxDepth = 0.0;
     double approach = 0.0;
-    for (auto& old : p->previous) old.matched = false;
     for (SolverContact& cp : p->contacts) {
       const Vec3& n = cp.c.normal;
-      cp.rA = cp.c.point - a.x;
-      cp.rB = cp.c.point - b.x;
+      // Both anchors moved with their bodies: their offset along the normal is this point's own
+      // separation now (a tilt makes one side deeper and the other shallower), and their midpoint
+      // is where the impulses act -- one point for both bodies, so impulses stay equal and
+      // opposite about one point and momentum is conserved exactly.
+      const Vec3 pA = a.x + a.q * cp.anchorA;
+      const Vec3 pB = b.x + b.q * cp.anchorB;
+      cp.separation = (pA - pB).dot(n);
+      cp.speculative = std::max(0.0, cp.separation) / h;
+      const Vec3 point = 0.5 * (pA + pB);
+      cp.rA = point - a.x;
+      cp.rB = point - b.x;
       tangents(n, cp.t1, cp.t2);
       auto effMass = [&](const Vec3& dir) {
         const Vec3 ra = cp.rA.cross(dir), rb = cp.rB.cross(dir);
@@ -309,7 +327,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance) {
       // comes from its distance field (errorBound there is the field's interpolation error, not
       // a doubt about contact), so it is corrected as it is.
       const double doubt = s.model == ContactModel::kContactTree ? 0.0 : cp.c.errorBound;
-      const double certain = cp.c.depth - doubt - s.slopRel * diag;
+      const double certain = -cp.separation - doubt - s.slopRel * diag;
       // Correction speed capped: a coarse contact's depth can be a large part of a body, and
       // removing a fifth of it per substep would teleport a small body through its neighbours.
       const double maxCorrection = kMaxCorrectionRel * diag;
@@ -319,33 +337,12 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance) {
       // Warm start only resting contact: re-applying last substep's impulse to a pair that is now
       // separating or approaching fast (a bounce) adds energy the iterations may not remove.
       const bool resting = std::abs(vn) < s.restitutionThreshold;
-      if (!p->fresh) {
-        // Kept contacts of a pair the budget skipped: their own impulses, if still resting.
-        if (!resting) cp.lambdaN = cp.lambdaT1 = cp.lambdaT2 = 0.0;
-        else {
-          cp.lambdaT1 = cp.frictionImpulse.dot(cp.t1);
-          cp.lambdaT2 = cp.frictionImpulse.dot(cp.t2);
-        }
-      } else if (resting) {
-        // A fresh contact inherits the impulse of the nearest unclaimed previous contact of
-        // this pair with nearly the same normal; one-to-one, so a manifold that grew does not
-        // apply one old impulse twice.
-        double best = matchDistance;
-        SolverContact* match = nullptr;
-        for (SolverContact& old : p->previous) {
-          if (old.matched || old.c.normal.dot(n) < kWarmStartNormalCos) continue;
-          const double d = (old.c.point - cp.c.point).norm();
-          if (d < best) {
-            best = d;
-            match = &old;
-          }
-        }
-        if (match) {
-          match->matched = true;
-          cp.lambdaN = match->lambdaN;
-          cp.lambdaT1 = match->frictionImpulse.dot(cp.t1);
-          cp.lambdaT2 = match->frictionImpulse.dot(cp.t2);
-        }
+      if (!resting) cp.lambdaN = 0.0;
+      if (resting) {
+        cp.lambdaT1 = cp.frictionImpulse.dot(cp.t1);
+        cp.lambdaT2 = cp.frictionImpulse.dot(cp.t2);
+      } else {
+        cp.lambdaT1 = cp.lambdaT2 = 0.0;
       }
       cp.lambdaP = 0.0;
     }
@@ -353,6 +350,49 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance) {
   }
   solve(h);
   integrate(h);
+}
+
+// Persistent contacts (as Bullet's persistent manifold and Box2D's contact ids do it): each new
+// contact of a freshly queried pair is matched one-to-one to the nearest unclaimed previous
+// contact of the pair with nearly the same normal and the same level. A match passes on its
+// accumulated normal and friction impulses (warm starting) and, while its two anchors have
+// neither slid apart nor opened by more than kAnchorDriftRel of the smaller diagonal, its
+// anchors too: the point stays where it was first found on both bodies, so its separation is
+// measured from the bodies' motion since then, point by point. That is what the narrow phase
+// cannot give the exact model, whose contacts share one pair-wide depth: a box that tilts on
+// another gets deeper anchors on one side and shallower (or open, speculative) ones on the
+// other, so the position correction rights it, and the velocity solve lets the open side come
+// down. A new contact without a match is anchored at its point, half its depth into each body.
+void World::Impl::persistContacts(PairState& p, const Body& a, const Body& b, double diag) {
+  const double matchDistance = 0.05 * diag;
+  const double drift = kAnchorDriftRel * diag;
+  for (auto& old : p.previous) old.matched = false;
+  for (SolverContact& cp : p.contacts) {
+    const Vec3& n = cp.c.normal;
+    double best = matchDistance;
+    SolverContact* match = nullptr;
+    for (SolverContact& old : p.previous) {
+      if (old.matched || old.c.normal.dot(n) < kWarmStartNormalCos) continue;
+      const Vec3 mid = 0.5 * (a.x + a.q * old.anchorA + b.x + b.q * old.anchorB);
+      const double d = (mid - cp.c.point).norm();
+      if (d < best) {
+        best = d;
+        match = &old;
+      }
+    }
+    cp.anchorA = a.q.conjugate() * (cp.c.point - 0.5 * cp.c.depth * n - a.x);
+    cp.anchorB = b.q.conjugate() * (cp.c.point + 0.5 * cp.c.depth * n - b.x);
+    if (!match) continue;
+    match->matched = true;
+    cp.lambdaN = match->lambdaN;
+    cp.frictionImpulse = match->frictionImpulse;
+    const Vec3 gap = a.x + a.q * match->anchorA - b.x - b.q * match->anchorB;
+    const double open = gap.dot(n);
+    if (match->c.level == cp.c.level && open < drift && (gap - open * n).norm() < drift) {
+      cp.anchorA = match->anchorA;
+      cp.anchorB = match->anchorB;
+    }
+  }
 }
 
 double World::Impl::kineticEnergyOfDynamicBodies() const {
@@ -413,7 +453,7 @@ void World::Impl::solve(double h) {
           maxChange = std::max(maxChange, std::abs(cp.lambdaT2 - old));
           vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
           old = cp.lambdaN;
-          cp.lambdaN = std::max(0.0, old - cp.massN * vr.dot(cp.c.normal));
+          cp.lambdaN = std::max(0.0, old - cp.massN * (vr.dot(cp.c.normal) + cp.speculative));
           apply(a, b, cp, (cp.lambdaN - old) * cp.c.normal);
           maxChange = std::max(maxChange, std::abs(cp.lambdaN - old));
           maxLambda = std::max(maxLambda, cp.lambdaN);
@@ -559,10 +599,10 @@ const StepReport& World::step(double dt) {
     const double speed = (b.v + m.settings.gravity * dt).norm() + b.w.norm() * 0.5 * b.localBox.diagonal();
     maxTravel = std::max(maxTravel, speed * dt);
   }
-  std::uint32_t n = 1;
+  std::uint32_t n = m.settings.minSubsteps;
   if (std::isfinite(minExtent) && maxTravel > 0.0) {
     const double want = std::ceil(maxTravel / (kTravelFraction * minExtent));
-    n = std::isfinite(want) ? std::uint32_t(std::clamp(want, 1.0, double(m.settings.maxSubsteps))) : m.settings.maxSubsteps;
+    n = std::isfinite(want) ? std::uint32_t(std::clamp(want, double(n), double(m.settings.maxSubsteps))) : m.settings.maxSubsteps;
   }
   m.report.substeps = n;
   m.report.testsBudget = m.settings.budgetTests;

@@ -156,14 +156,17 @@ TEST(World, BoxDroppedFlatComesToRestFlatWithEveryModelAndBudget) {
   }
 }
 
-// Known failure (docs/dynamics.md): at the default 20 iterations the stack stands but rocks: the
-// top box moves 0.107 m (limit 0.01) and tilts up to ~1.5 degrees; 80 iterations: 0.024 m.
-TEST(World, DISABLED_StackOfTenBoxesStandsForTenSeconds) {
+// The stack stands at the default 20 iterations with 8 substeps per 1/60 s step (scene setting
+// minSubsteps; scenes/stack_10.json uses the same): Gauss-Seidel passes support down a 10-box
+// stack too slowly within one 1/60 s solve, and with one substep the stack rocks 0.13 m
+// (docs/dynamics.md, Known limits, has the measured table).
+TEST(World, StackOfTenBoxesStandsForTenSeconds) {
   const auto slab = bakeShape(makeBox(Vec3(3.0, 3.0, 0.25)));
   WorldSettings ws;
   // The polygon-level model: true depths, so penetration correction holds the stack up.
   ws.model = ContactModel::kExact;
   ws.velocityIterations = 20;
+  ws.minSubsteps = 8;
   World world(ws);
   RigidBodyDesc ground;
   ground.shape = slab;
@@ -177,28 +180,24 @@ TEST(World, DISABLED_StackOfTenBoxesStandsForTenSeconds) {
     box.friction = 0.6;
     world.addBody(box);
   }
-  // Let the stack settle for 1 s, then measure the top box over 10 simulated seconds.
+  // Let the stack settle for 1 s, then measure the top box over 10 simulated seconds (2 s under
+  // the sanitizers, which run ~10x slower).
   const int settle = 60, steps = sanitizerRun() ? 120 : 600;
   for (int i = 0; i < settle; ++i) world.step(1.0 / 60.0);
   const Vec3 top0 = world.state(10).position;
-  double maxMove = 0.0;
+  double maxMove = 0.0, maxTilt = 0.0;
   for (int i = 0; i < steps; ++i) {
-    const StepReport& r = world.step(1.0 / 60.0);
+    world.step(1.0 / 60.0);
     maxMove = std::max(maxMove, (world.state(10).position - top0).norm());
-    if (std::getenv("CLOD_DEBUG_CONTACTS") && i % 30 == 0) {
-      for (std::size_t k = 0; k < r.contacts.size(); ++k)
-        std::printf("%d pair %u-%u p %.4f %.4f %.4f n %.5f %.5f %.5f d %.5f lvl %u\n", i, r.contactBodies[k][0],
-                    r.contactBodies[k][1], r.contacts[k].point.x(), r.contacts[k].point.y(), r.contacts[k].point.z(),
-                    r.contacts[k].normal.x(), r.contacts[k].normal.y(), r.contacts[k].normal.z(), r.contacts[k].depth,
-                    r.contacts[k].level);
-    }
-    if (std::getenv("CLOD_DEBUG_STACK") && i % 30 == 0)
-      for (int k = 1; k <= 10; ++k)
-        std::printf("%d box%d %.4f %.4f %.4f tilt %.3f\n", i, k, world.state(k).position.x(), world.state(k).position.y(),
-                    world.state(k).position.z(), tiltDegrees(world.state(k).orientation));
+    maxTilt = std::max(maxTilt, tiltDegrees(world.state(10).orientation));
   }
-  EXPECT_LT(maxMove, 0.01 * 1.0);  // 1 % of the box size (1 m)
-  EXPECT_LT(tiltDegrees(world.state(10).orientation), 1.0);
+  // The criterion: the top box moves less than 1 % of its size (1 m).
+  EXPECT_LT(maxMove, 0.01 * 1.0);
+  // A box that rocks by 1 degree moves its top corner by 9 mm at this height: the same bound.
+  EXPECT_LT(maxTilt, 1.0);
+  // Still a stack: the top box about 9.75 m up (10 boxes on a slab whose top is at 0.25; each
+  // contact may sink by the slop, 0.2 % of the box diagonal, 3.5 mm, so at most 35 mm in all).
+  EXPECT_GT(world.state(10).position.z(), 9.75 - 0.035);
 }
 
 TEST(World, FastBallDoesNotTunnelThroughThinBox) {
