@@ -10,6 +10,10 @@
 //   world_compare [--scene FILE] [--cache DIR] [--steps N] [--models dos,cfm,contact-tree,exact]
 //                 [--budgets 1024,4096,16384,0] [--bullet gimpact,hull|none]
 //                 [--bullet-substeps 1,clod] [--bullet-steps N] [--bullet-iterations N]
+//                 [--row-seconds S]
+// --row-seconds (default 180, 0 = no cap) ends a row whose frames have taken S seconds of wall
+// time; the row then reports the steps it did ("37 of 240 (capped)") and its outcome columns
+// describe the pile at that step, not at the end.
 // Budget 0 (or "unlimited") = no budget. Rows go to stdout as a markdown table; progress and
 // per-row notes go to stderr. Exit status 2 for bad usage, 1 for bad data (clod::Error).
 //
@@ -72,6 +76,7 @@ struct Options {
   std::vector<std::uint32_t> bulletSubsteps = {1, 0};  // 0 = "clod"
   std::uint32_t bulletSteps = 0;  // 0 = same as clod
   int bulletIterations = 20;
+  double rowSeconds = 180.0;  // a row stops after this much wall time (0 = never)
 };
 
 struct UsageError {
@@ -106,7 +111,11 @@ Options parseOptions(int argc, char** argv) {
     else if (flag == "--cache") o.cache = value;
     else if (flag == "--steps") o.steps = std::uint32_t(parseCount(flag, value));
     else if (flag == "--bullet-steps") o.bulletSteps = std::uint32_t(parseCount(flag, value));
-    else if (flag == "--bullet-iterations") o.bulletIterations = int(std::max<std::uint64_t>(1, parseCount(flag, value)));
+    else if (flag == "--row-seconds") {
+      char* end = nullptr;
+      o.rowSeconds = std::strtod(value.c_str(), &end);
+      if (value.empty() || *end != '\0' || !(o.rowSeconds >= 0.0)) throw UsageError{"--row-seconds: expected seconds >= 0"};
+    } else if (flag == "--bullet-iterations") o.bulletIterations = int(std::max<std::uint64_t>(1, parseCount(flag, value)));
     else if (flag == "--models") {
       o.models = value == "none" ? std::vector<std::string>{} : splitList(value);
       for (const std::string& m : o.models) clod::parseContactModel(m);  // throws kInvalidArgument
@@ -152,7 +161,8 @@ double percentile(std::vector<double> v, double p) {
 // What a row reports. Outcome figures are measured the same way for clod and Bullet.
 struct Row {
   std::string engine, model, budget;
-  std::uint32_t steps = 0;
+  std::uint32_t steps = 0;    // asked for
+  std::uint32_t stepsRun = 0; // done: fewer when the row hit --row-seconds
   std::vector<double> wall, cpu;
   std::uint64_t maxTests = 0;
   std::vector<double> substeps;
@@ -212,6 +222,16 @@ void finishOutcome(Row& row, const Bin& bin, const std::vector<Vec3>& centres) {
   row.meanZ = in ? z / in : 0.0;
 }
 
+// True when the row's frames so far took longer than the cap (then the row ends early and says so).
+bool overTime(const Row& row, double rowSeconds) {
+  double total = 0.0;
+  for (double w : row.wall) total += w;
+  if (rowSeconds <= 0.0 || total <= rowSeconds) return false;
+  std::cerr << "\n  row stopped after " << row.wall.size() << " of " << row.steps << " steps (--row-seconds "
+            << rowSeconds << ")\n";
+  return true;
+}
+
 void progress(const std::string& label, std::uint32_t step, std::uint32_t steps) {
   if (step % 20 == 0 || step == steps) std::cerr << "\r  " << label << ": " << step << '/' << steps << std::flush;
   if (step == steps) std::cerr << '\n';
@@ -223,7 +243,7 @@ void progress(const std::string& label, std::uint32_t step, std::uint32_t steps)
 // each budget row then starts from a fresh World with the template's bodies (descs hold the
 // initial state and share the baked shapes), so the contact trees are built once per run.
 Row runClod(const clod::World& tmpl, const clod::SceneDescription& scene, clod::ContactModel model,
-            std::uint64_t budget, std::uint32_t steps, const Bin& bin) {
+            std::uint64_t budget, std::uint32_t steps, double rowSeconds, const Bin& bin) {
   clod::WorldSettings ws = scene.world;
   ws.model = model;
   ws.budgetTests = budget;
@@ -244,7 +264,9 @@ Row runClod(const clod::World& tmpl, const clod::SceneDescription& scene, clod::
     row.maxTests = std::max(row.maxTests, r.testsSpent);
     row.substeps.push_back(r.substeps);
     row.leftBounds += std::uint32_t(r.leftBounds.size());
+    row.stepsRun = s;
     progress(label, s, steps);
+    if (overTime(row, rowSeconds)) break;
   }
   std::vector<Vec3> centres;
   for (BodyId i = 0; i < world.bodyCount(); ++i) {
@@ -390,7 +412,7 @@ struct BulletScene {
 };
 
 Row runBullet(const clod::World& tmpl, const clod::SceneDescription& scene, bool hull, std::uint32_t substeps,
-              std::uint32_t steps, int iterations, const Bin& bin) {
+              std::uint32_t steps, int iterations, double rowSeconds, const Bin& bin) {
   BulletScene b(tmpl, scene, hull, iterations);
   Row row;
   row.engine = "Bullet 3.24";
@@ -420,7 +442,9 @@ Row runBullet(const clod::World& tmpl, const clod::SceneDescription& scene, bool
         b.world.removeRigidBody(&body);
       }
     }
+    row.stepsRun = s;
     progress(label, s, steps);
+    if (overTime(row, rowSeconds)) break;
   }
   std::vector<Vec3> centres;
   for (std::size_t i = 0; i < b.bodies.size(); ++i) {
@@ -459,16 +483,21 @@ std::string withCommas(std::uint64_t v) {
 
 void printTable(const std::vector<Row>& rows) {
   std::cout << "| engine | model / shape | budget (tests/frame) | steps | substeps/frame (median) | median ms | p99 ms"
-               " | p99/median | max ms | CPU median ms | max tests/frame | left bounds | outside bin at end"
+                " | p99/median | max ms | CPU median ms | CPU p99 ms | CPU p99/median | max tests/frame | left bounds | outside bin at end"
                " | KE at end J | mean z at end m |\n"
-               "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+               "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
     const double med = 1e3 * percentile(r.wall, 0.5), p99 = 1e3 * percentile(r.wall, 0.99);
     const double mx = 1e3 * percentile(r.wall, 1.0);
-    std::cout << "| " << r.engine << " | " << r.model << " | " << r.budget << " | " << r.steps << " | "
+    const double cmed = percentile(r.cpu, 0.5), cp99 = percentile(r.cpu, 0.99);
+    std::cout << "| " << r.engine << " | " << r.model << " | " << r.budget << " | "
+              << (r.stepsRun == r.steps ? std::to_string(r.steps)
+                                        : std::to_string(r.stepsRun) + " of " + std::to_string(r.steps) + " (capped)")
+              << " | "
               << fmt(percentile(r.substeps, 0.5), 0) << " | " << fmt(med, 2) << " | " << fmt(p99, 2) << " | "
               << fmt(med > 0 ? p99 / med : 0.0, 2) << " | " << fmt(mx, 2) << " | "
-              << fmt(1e3 * percentile(r.cpu, 0.5), 2) << " | "
+              << fmt(1e3 * cmed, 2) << " | " << fmt(1e3 * cp99, 2) << " | " << fmt(cmed > 0 ? cp99 / cmed : 0.0, 2)
+              << " | "
               << (r.engine == "clod" ? withCommas(r.maxTests) : std::string("-")) << " | " << r.leftBounds << " | "
               << r.outsideBin << " | " << fmt(r.keEnd, 3) << " | " << fmt(r.meanZ, 3) << " |\n";
   }
@@ -494,7 +523,7 @@ int run(const Options& o) {
               << fmt(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1) << " s ("
               << rep.shapesBaked << " shapes baked, " << rep.shapesFromCache << " from cache)\n";
     for (std::uint64_t budget : o.budgets) {
-      rows.push_back(runClod(tmpl, s, s.world.model, budget, steps, bin));
+      rows.push_back(runClod(tmpl, s, s.world.model, budget, steps, o.rowSeconds, bin));
       printTable({rows.back()});
     }
     if (!any) any.emplace(std::move(tmpl));
@@ -512,7 +541,7 @@ int run(const Options& o) {
     for (const std::string& kind : o.bullet)
       for (std::uint32_t k : o.bulletSubsteps) {
         if (k == 0) k = clodRate;
-        rows.push_back(runBullet(*any, scene, kind == "hull", k, bulletSteps, o.bulletIterations, bin));
+        rows.push_back(runBullet(*any, scene, kind == "hull", k, bulletSteps, o.bulletIterations, o.rowSeconds, bin));
         rows.back().model += " (" + std::to_string(k) + " substep" + (k > 1 ? "s" : "") + ")";
         printTable({rows.back()});
       }
@@ -534,7 +563,8 @@ int main(int argc, char** argv) {
     if (!e.message.empty()) std::cerr << "world_compare: " << e.message << '\n';
     std::cerr << "usage: world_compare [--scene FILE] [--cache DIR] [--steps N] [--models dos,cfm,contact-tree,exact|none]\n"
                  "                     [--budgets 1024,4096,16384,unlimited] [--bullet gimpact,hull|none]\n"
-                 "                     [--bullet-substeps 1,clod] [--bullet-steps N] [--bullet-iterations N]\n";
+                 "                     [--bullet-substeps 1,clod] [--bullet-steps N] [--bullet-iterations N]\n"
+                 "                     [--row-seconds S]\n";
     return e.message.empty() ? 0 : 2;
   } catch (const clod::Error& e) {
     std::cerr << "world_compare: " << e.what() << '\n';
