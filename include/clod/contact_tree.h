@@ -13,23 +13,30 @@
 // Frames and units: everything is in the body frame of the mesh the tree was built from, in the
 // mesh's length unit. Signed distance is negative inside.
 //
-// Layout (flat arrays, 32-bit indices, breadth-first):
+// Layout (flat arrays, 32-bit indices, breadth-first; docs/contact-tree.md has the byte counts):
 //  * Node 0 is the root cell, the cube [origin, origin + rootSize]^3. The eight children of an
-//    interior node are contiguous, starting at firstChild[node]; child k covers octant k, where
-//    bit 0 of k selects the upper half in x, bit 1 in y and bit 2 in z. Leaves have firstChild 0
-//    (no node has the root as a child). Nodes of depth d are [levelOffsets[d], levelOffsets[d+1]).
+//    interior node are contiguous; child k covers octant k, where bit 0 of k selects the upper
+//    half in x, bit 1 in y and bit 2 in z. Nodes of depth d are [levelOffsets[d],
+//    levelOffsets[d+1]).
+//  * Tree shape as a bitmap with rank counts (nodeWords): bit i of the interior bitmap is set
+//    when node i is split. Because the layout is breadth-first, the children of the k-th
+//    interior node (counting from 0 in node order) start at node 1 + 8k, so firstChild(i) is a
+//    rank query -- one 24-byte word per 64 nodes (3 bits per node) instead of a 32-bit child
+//    index. A second bitmap marks surface cells, whose half-space is halfSpaces[rank].
 //  * Corner values are shared: the root's 8 corner distances are in rootCorners; an interior
 //    node splitting its cell introduces the 3x3x3 lattice of its children's corners, of which the
 //    8 cell corners are already known, so it stores only the 19 new values, once, however many
-//    children share them (values lattice[19*b .. 19*b+19), b = (firstChild - 1) / 8, in lattice
+//    children share them (values lattice[19*k .. 19*k+19) for the k-th interior node, in lattice
 //    order i + 3j + 9k with the 8 even-even-even points left out). A query inherits a cell's
-//    corners from its parent while descending: 8 float loads per level, no indirection table.
-//  * errorBound, halfSpaceIndex: one entry per node. halfSpaces: one entry per surface cell.
+//    corners from its parent while descending: no indirection table.
+//  * errorCode: one 16-bit entry per node, the node's error bound as a fraction of its cell's
+//    bounding-sphere radius, rounded up (see errorBound()).
 //
 // Cells are half-open: a point on a face shared by two cells belongs to the upper one, except
 // on the root cube's upper faces, which belong to the root.
 
 #include <array>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -55,6 +62,15 @@ struct ContactHalfSpace {
   /// within one cell diagonal of the surface: how planar the surface is in the cell. 0 for a
   /// flat face; of the order of the cell size where an edge or corner crosses the cell.
   float fitError;
+};
+
+/// 64 nodes' worth of the tree shape (see the layout comment of ContactTree): bit b of
+/// `interior` / `surface` is node 64w + b; the counts are the set bits in all earlier words.
+struct ContactTreeNodeWord {
+  std::uint64_t interior = 0;
+  std::uint64_t surface = 0;
+  std::uint32_t interiorBefore = 0;
+  std::uint32_t surfaceBefore = 0;
 };
 
 /// A node together with the geometry a traversal derives on the way down (nothing of this is
@@ -98,15 +114,15 @@ struct ContactTree {
 
   // --- Per node (breadth-first) ------------------------------------------------------------
   std::array<float, 8> rootCorners{};
-  std::vector<std::uint32_t> firstChild;  ///< 0 for a leaf
-  /// Interpolation error bound of the node's cell: the largest |trilinear - exact| measured at
-  /// the cell's test points (docs/contact-tree.md: 3x3x3 lattice + 8 octant centres), or, for a
-  /// cell the builder proved far from the surface without measuring, the Lipschitz bound of
-  /// half the cell diagonal, which holds everywhere in the cell for any 1-Lipschitz field.
-  /// This is what a query stopped at this node reports, and what graceful degradation uses.
-  std::vector<float> errorBound;
-  std::vector<std::uint32_t> halfSpaceIndex;  ///< into halfSpaces, or kNoHalfSpace
-  std::vector<std::uint32_t> levelOffsets;    ///< size depthCount() + 1
+  /// Shape and surface bitmaps with rank counts, one word per 64 nodes (see the layout above).
+  std::vector<ContactTreeNodeWord> nodeWords;
+  /// Per node: its error bound divided by cellRadius(depth), as the upper 16 bits of an IEEE
+  /// float (sign 0, 8-bit exponent, 7-bit mantissa), rounded up, so that the decoded bound is
+  /// never below the builder's and at most 2^-7 (0.8 %) above it; 0x3f80 (1.0) is the Lipschitz
+  /// bound of half the cell diagonal, which caps every bound except in cells where the builder
+  /// found the field discontinuous (open meshes, docs/contact-tree.md). Use errorBound().
+  std::vector<std::uint16_t> errorCode;
+  std::vector<std::uint32_t> levelOffsets;  ///< size depthCount() + 1
 
   // --- Shared pools ------------------------------------------------------------------------
   std::vector<float> lattice;                ///< 19 values per interior node, see above
@@ -125,18 +141,58 @@ struct ContactTree {
   /// entries no such node touches are 0 and never read.
   std::vector<float> gridCorners;
   /// (Re)derives gridDepth, gridNode and gridCorners from the node arrays: gridDepth is the
-  /// largest d <= 3 with d < depthCount() and 8^d <= nodeCount() / 8 (a deeper grid measured
-  /// slower: it falls out of the L1 cache), so the grid costs at most ~5 KiB.
-  /// O(8^gridDepth). Precondition: a valid tree.
-  void buildLookupGrid();
+  /// largest d <= depthCap with d < depthCount() and 8^d <= nodeCount() / 8, so the grid's
+  /// node entries never outnumber an eighth of the nodes; the default cap 5 costs at most
+  /// 268 KiB (docs/benchmarks/contact_tree.md compares depths: with the 3-bit-per-node shape
+  /// bitmap the descent below the grid stays in L2, and depth 5 was the fastest).
+  /// O(8^gridDepth). Precondition: a valid tree, depthCap <= 8.
+  void buildLookupGrid(std::uint32_t depthCap = 5);
 
   // --- Size ---------------------------------------------------------------------------------
-  std::uint32_t nodeCount() const { return static_cast<std::uint32_t>(firstChild.size()); }
+  std::uint32_t nodeCount() const { return levelOffsets.empty() ? 0 : levelOffsets.back(); }
   /// Number of depths present (the deepest leaf's depth + 1); 0 for an empty tree.
   std::uint32_t depthCount() const {
     return levelOffsets.empty() ? 0 : static_cast<std::uint32_t>(levelOffsets.size() - 1);
   }
-  bool isLeaf(std::uint32_t node) const { return firstChild[node] == 0; }
+  /// True when `node` is not split. O(1). Precondition: node < nodeCount().
+  bool isLeaf(std::uint32_t node) const { return ((nodeWords[node >> 6].interior >> (node & 63)) & 1u) == 0; }
+  /// Index of the first of the eight children of `node`, or 0 for a leaf (no node has the
+  /// root as a child). O(1): a rank query on the interior bitmap.
+  std::uint32_t firstChild(std::uint32_t node) const {
+    const ContactTreeNodeWord& w = nodeWords[node >> 6];
+    const std::uint64_t upTo = w.interior & (~std::uint64_t{0} >> (63 - (node & 63)));
+    if (((w.interior >> (node & 63)) & 1u) == 0) return 0;
+    return 1 + 8 * (w.interiorBefore + static_cast<std::uint32_t>(std::popcount(upTo)) - 1);
+  }
+  /// Index into halfSpaces of a surface cell's half-space, or kNoHalfSpace. O(1).
+  std::uint32_t halfSpaceIndex(std::uint32_t node) const {
+    const ContactTreeNodeWord& w = nodeWords[node >> 6];
+    if (((w.surface >> (node & 63)) & 1u) == 0) return kNoHalfSpace;
+    const std::uint64_t below = w.surface & ((std::uint64_t{1} << (node & 63)) - 1);
+    return w.surfaceBefore + static_cast<std::uint32_t>(std::popcount(below));
+  }
+  /// Interpolation error bound of the node's cell, in mesh units: the largest |trilinear -
+  /// exact| measured at the cell's test points times the gap factor (docs/contact-tree.md:
+  /// 3x3x3 lattice + 8 octant centres), or, for a cell the builder proved far from the surface
+  /// without measuring, the Lipschitz bound of half the cell diagonal, which holds everywhere in
+  /// the cell for any 1-Lipschitz field; never more than that, except in cells where the field
+  /// is discontinuous (open meshes: the measured bound, uncapped). Rounded up by at most 0.8 %
+  /// (errorCode). This is what a query stopped at this node reports, and what graceful
+  /// degradation uses. `depth` must be the node's depth. O(1).
+  double errorBound(std::uint32_t node, std::uint32_t depth) const {
+    return decodeErrorRatio(errorCode[node]) * cellRadius(depth);
+  }
+  /// The 16-bit code of a ratio bound / cell radius (upper half of its float), rounded up so
+  /// that decodeErrorRatio(code) >= ratio; ratios beyond the float range map to the largest
+  /// finite code 0x7f7f. Precondition: ratio >= 0, not NaN.
+  static std::uint16_t encodeErrorRatio(double ratio);
+  /// Inverse of encodeErrorRatio: a float whose upper 16 bits are `code`.
+  static float decodeErrorRatio(std::uint16_t code) {
+    return std::bit_cast<float>(static_cast<std::uint32_t>(code) << 16);
+  }
+  /// Fills nodeWords from per-node flags (1 = split / surface cell), both nodeCount() long.
+  /// O(nodeCount()).
+  void assignNodeBits(const std::vector<std::uint8_t>& interior, const std::vector<std::uint8_t>& surface);
   /// Bytes held by the arrays, lookup grid included (excluding vector capacity slack and the
   /// struct itself).
   std::size_t memoryBytes() const;
@@ -166,7 +222,7 @@ struct ContactTree {
   ContactCell childCell(const ContactCell& cell, std::uint32_t octant) const;
   /// The half-space of a surface cell, or nullptr if the surface does not cross the cell.
   const ContactHalfSpace* halfSpace(std::uint32_t node) const {
-    const std::uint32_t i = halfSpaceIndex[node];
+    const std::uint32_t i = halfSpaceIndex(node);
     return i == kNoHalfSpace ? nullptr : &halfSpaces[i];
   }
   /// Lower bound of the true signed distance anywhere in the cell: the smallest corner value

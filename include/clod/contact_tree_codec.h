@@ -1,12 +1,13 @@
 #pragma once
 // Binary encoding of a contact tree, for the contact-tree section of the bake file.
 //
-// Layout (little-endian, ByteWriter conventions; version 1):
+// Layout (little-endian, ByteWriter conventions; version 2):
 //   u32 version, f64 origin[3], f64 rootSize, f64 meshDiagonal, f64 errorAbs, f64 bandAbs,
-//   u32 maxDepth, f32 rootCorners[8], then arrays (u64 count + elements): firstChild (u32),
-//   errorBound (f32), halfSpaceIndex (u32), levelOffsets (u32), lattice (f32),
-//   halfSpaces (20-byte records: f32 normal[3], f32 offset, f32 fitError).
-// The encoding is a memory image of the arrays: decoding is a validated copy, no rebuilding.
+//   u32 maxDepth, f32 rootCorners[8], then arrays (u64 count + elements): levelOffsets (u32),
+//   interior bitmap (u64, one bit per node), surface bitmap (u64), errorCode (u16),
+//   lattice (f32), halfSpaces (20-byte records: f32 normal[3], f32 offset, f32 fitError).
+// The rank counts of ContactTree::nodeWords are derived on decoding. Version 1 (32-bit child
+// and half-space indices, f32 error bounds) is refused with kBakeVersion: re-bake.
 
 #include "clod/byte_stream.h"
 #include "clod/contact_tree.h"
@@ -14,7 +15,7 @@
 namespace clod {
 
 /// Version written by encodeContactTree and the only one decodeContactTree accepts.
-inline constexpr std::uint32_t kContactTreeCodecVersion = 1;
+inline constexpr std::uint32_t kContactTreeCodecVersion = 2;
 
 /// Appends `tree` to `out`. Precondition: the tree came from buildContactTree or
 /// decodeContactTree (its invariants hold). Deterministic: equal trees give equal bytes.

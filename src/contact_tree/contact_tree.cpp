@@ -1,6 +1,7 @@
 #include "clod/contact_tree.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "clod/error.h"
@@ -31,27 +32,62 @@ double interpolateTrilinear(const std::array<float, 8>& c, const Vec3& t, Vec3* 
 }
 
 std::size_t ContactTree::memoryBytes() const {
-  return firstChild.size() * sizeof(std::uint32_t) + errorBound.size() * sizeof(float) +
-         halfSpaceIndex.size() * sizeof(std::uint32_t) + levelOffsets.size() * sizeof(std::uint32_t) +
+  return nodeWords.size() * sizeof(ContactTreeNodeWord) + errorCode.size() * sizeof(std::uint16_t) +
+         levelOffsets.size() * sizeof(std::uint32_t) +
          lattice.size() * sizeof(float) + halfSpaces.size() * sizeof(ContactHalfSpace) + sizeof(rootCorners) +
          gridNode.size() * sizeof(std::uint32_t) + gridCorners.size() * sizeof(float);
 }
 
-void ContactTree::buildLookupGrid() {
+std::uint16_t ContactTree::encodeErrorRatio(double ratio) {
+  CLOD_ASSERT(ratio >= 0.0);
+  // Ratios above 1 occur only where the builder found the field discontinuous (open meshes);
+  // they must stay representable, or the bound would understate the error there.
+  if (!(ratio < 3.0e38)) return 0x7f7f;  // the largest finite bfloat16
+  // Round up twice: double -> float, then float -> its upper 16 bits (a bfloat16). Both steps
+  // only make the bound larger, so the decoded bound stays a bound.
+  float f = static_cast<float>(ratio);
+  if (static_cast<double>(f) < ratio) f = std::nextafter(f, 2.0f);
+  const std::uint32_t bits = std::bit_cast<std::uint32_t>(f);
+  std::uint32_t code = bits >> 16;
+  if ((bits & 0xffffu) != 0) ++code;  // positive floats: a larger bit pattern is a larger value
+  return static_cast<std::uint16_t>(std::min<std::uint32_t>(code, 0x7f7f));
+}
+
+void ContactTree::assignNodeBits(const std::vector<std::uint8_t>& interior, const std::vector<std::uint8_t>& surface) {
+  const std::size_t n = interior.size();
+  CLOD_ASSERT(surface.size() == n);
+  nodeWords.assign((n + 63) / 64, ContactTreeNodeWord{});
+  std::uint32_t interiorCount = 0, surfaceCount = 0;
+  for (std::size_t w = 0; w < nodeWords.size(); ++w) {
+    ContactTreeNodeWord& word = nodeWords[w];
+    word.interiorBefore = interiorCount;
+    word.surfaceBefore = surfaceCount;
+    for (std::size_t b = 0; b < 64 && 64 * w + b < n; ++b) {
+      if (interior[64 * w + b]) word.interior |= std::uint64_t{1} << b;
+      if (surface[64 * w + b]) word.surface |= std::uint64_t{1} << b;
+    }
+    interiorCount += static_cast<std::uint32_t>(std::popcount(word.interior));
+    surfaceCount += static_cast<std::uint32_t>(std::popcount(word.surface));
+  }
+}
+
+void ContactTree::buildLookupGrid(std::uint32_t depthCap) {
+  CLOD_ASSERT(depthCap <= 8);
   gridDepth = 0;
   gridNode.clear();
   gridCorners.clear();
   std::uint32_t d = 0;
-  // Depth 5 (272 KiB) measured 13-20 % slower than no grid: it is colder in the cache than
-  // the top tree levels it replaces. Depth 3 (4.9 KiB) stays L1-resident.
-  while (d < 3 && d + 1 < depthCount() && (std::uint64_t{1} << (3 * (d + 1))) <= nodeCount() / 8) ++d;
+  // With 32-bit child indices (codec version 1) a depth-5 grid measured 13-20 % slower than
+  // none: the node array did not fit in L2 either way. With the shape bitmap (3 bits per node)
+  // the descent is L2-resident and the grid saves its top levels: depth 5 measured fastest.
+  while (d < depthCap && d + 1 < depthCount() && (std::uint64_t{1} << (3 * (d + 1))) <= nodeCount() / 8) ++d;
   if (d == 0) return;
   gridDepth = d;
   const std::uint32_t n = 1u << d, m = n + 1;
   gridNode.assign(std::size_t{n} * n * n, 0);
   gridCorners.assign(std::size_t{m} * m * m, 0.0f);
   // Depth-first walk over the cells down to depth d; O(8^d).
-  ContactCell stack[6 * 8];
+  ContactCell stack[8 * 8];
   int top = 0;
   stack[top++] = rootCell();
   while (top > 0) {
@@ -69,15 +105,15 @@ void ContactTree::buildLookupGrid() {
 }
 
 ContactCell ContactTree::rootCell() const {
-  CLOD_ASSERT(!firstChild.empty());
+  CLOD_ASSERT(nodeCount() > 0);
   ContactCell cell;
   cell.corners = rootCorners;
   return cell;
 }
 
 ContactCell ContactTree::childCell(const ContactCell& cell, std::uint32_t octant) const {
-  CLOD_ASSERT(octant < 8 && firstChild[cell.node] != 0);
-  const std::uint32_t first = firstChild[cell.node];
+  const std::uint32_t first = firstChild(cell.node);
+  CLOD_ASSERT(octant < 8 && first != 0);
   const float* pool = lattice.data() + std::size_t{(first - 1) / 8} * kContactTreeLatticePerNode;
   ContactCell child;
   child.node = first + octant;
@@ -89,7 +125,7 @@ ContactCell ContactTree::childCell(const ContactCell& cell, std::uint32_t octant
 }
 
 ContactCell ContactTree::cellAt(const Vec3& p, std::uint32_t maxDepthQuery) const {
-  CLOD_ASSERT(!firstChild.empty() && p.allFinite());
+  CLOD_ASSERT(nodeCount() > 0 && p.allFinite());
   const Vec3 u = ((p - origin) / rootSize).cwiseMax(0.0).cwiseMin(1.0);
   ContactCell cell = rootCell();
   while (cell.depth < maxDepthQuery && !isLeaf(cell.node)) {
@@ -106,15 +142,15 @@ ContactCell ContactTree::cellAt(const Vec3& p, std::uint32_t maxDepthQuery) cons
 }
 
 double ContactTree::minDistance(const ContactCell& cell) const {
-  return *std::min_element(cell.corners.begin(), cell.corners.end()) - double(errorBound[cell.node]);
+  return *std::min_element(cell.corners.begin(), cell.corners.end()) - errorBound(cell.node, cell.depth);
 }
 
 double ContactTree::maxDistance(const ContactCell& cell) const {
-  return *std::max_element(cell.corners.begin(), cell.corners.end()) + double(errorBound[cell.node]);
+  return *std::max_element(cell.corners.begin(), cell.corners.end()) + errorBound(cell.node, cell.depth);
 }
 
 ContactFieldSample ContactTree::sample(const Vec3& p, std::uint32_t maxDepthQuery) const {
-  CLOD_ASSERT(!firstChild.empty() && p.allFinite());
+  CLOD_ASSERT(nodeCount() > 0 && p.allFinite());
   ContactFieldSample out;
   Vec3 u = (p - origin) / rootSize;
   const Vec3 uClamped = u.cwiseMax(0.0).cwiseMin(1.0);
@@ -134,14 +170,13 @@ ContactFieldSample ContactTree::sample(const Vec3& p, std::uint32_t maxDepthQuer
   }
   // Descend without gathering corners: record each level's lattice block and octant, then
   // resolve the final cell's corners. Corner c of a cell entered through octant o comes from
-  // the parent's block unless c == o, in which case it is the parent's own corner c -- so each
-  // corner is found by walking back to the deepest level whose octant differs (1 step in 7 of
-  // 8 cases), instead of copying 8 values at every level.
+  // the parent's block unless c == o, in which case it is the parent's own corner c, found by
+  // walking back to the deepest level whose octant differs.
   //
-  // The descent is a chain of dependent loads (firstChild of the next level needs this one's),
-  // so its cost is memory latency, not arithmetic. The lookup grid replaces the top gridDepth
-  // levels by one load. (Prefetching every level's lattice block, to overlap the final corner
-  // loads with the last firstChild load, measured slower: it doubles the lines in flight.)
+  // Measured (docs/benchmarks/contact_tree.md): the descent itself is cheap -- the rank
+  // bitmap is 3 bits per node and stays in L2 -- and the query's cost is the cache miss on the
+  // final lattice block. Each level's block is therefore prefetched as soon as its address is
+  // known, so the last block's miss overlaps the last levels of the descent.
   const float* blocks[32];
   std::uint8_t octants[32];
   std::uint32_t node = 0;
@@ -154,33 +189,53 @@ ContactFieldSample ContactTree::sample(const Vec3& p, std::uint32_t maxDepthQuer
     const std::uint32_t start = gridNode[gridCell];
     if (start != 0) node = start, depth = startDepth = gridDepth;
   }
-  const std::uint32_t* children = firstChild.data();
+  const ContactTreeNodeWord* words = nodeWords.data();
   const float* pool = lattice.data();
   while (depth < maxDepthQuery) {
-    const std::uint32_t first = children[node];
-    if (first == 0) break;
+    const ContactTreeNodeWord& w = words[node >> 6];
+    const std::uint32_t b = node & 63;
+    if (((w.interior >> b) & 1u) == 0) break;
+    // Rank of this interior node = interior nodes before it; its children start at 1 + 8 rank.
+    const std::uint64_t below = w.interior & ((std::uint64_t{1} << b) - 1);
+    const std::uint32_t rank = w.interiorBefore + static_cast<std::uint32_t>(std::popcount(below));
+    const float* block = pool + std::size_t{rank} * kContactTreeLatticePerNode;
+    __builtin_prefetch(block);
+    __builtin_prefetch(block + kContactTreeLatticePerNode - 1);
     const std::uint32_t bit = 30 - depth;
     const std::uint32_t octant =
         ((fixed[0] >> bit) & 1u) | (((fixed[1] >> bit) & 1u) << 1) | (((fixed[2] >> bit) & 1u) << 2);
     ++depth;
-    const float* block = pool + std::size_t{(first - 1) >> 3} * kContactTreeLatticePerNode;
     blocks[depth] = block;
     octants[depth] = static_cast<std::uint8_t>(octant);
-    node = first + octant;
+    node = 1 + 8 * rank + octant;
   }
   std::array<float, 8> corners;
-  for (std::uint32_t c = 0; c < 8; ++c) {
-    std::uint32_t level = depth;
-    while (level > startDepth && octants[level] == c) --level;
-    if (level > startDepth) {
-      corners[c] = blocks[level][kChildCornerSlot[octants[level]][c]];
-    } else if (startDepth == 0) {
-      corners[c] = rootCorners[c];
+  if (depth == startDepth) {
+    if (startDepth == 0) {
+      corners = rootCorners;
     } else {
-      // Corner c of the grid cell (rare: every octant below the grid equals c).
       const std::size_t n = std::size_t{1} << gridDepth, m = n + 1;
       const std::size_t ix = gridCell % n, iy = (gridCell / n) % n, iz = gridCell / (n * n);
-      corners[c] = gridCorners[(ix + (c & 1)) + m * ((iy + ((c >> 1) & 1)) + m * (iz + (c >> 2)))];
+      for (std::uint32_t c = 0; c < 8; ++c)
+        corners[c] = gridCorners[(ix + (c & 1)) + m * ((iy + ((c >> 1) & 1)) + m * (iz + (c >> 2)))];
+    }
+  } else {
+    // Seven corners come from the last block (kChildCornerSlot maps the eighth, o, to a valid
+    // slot whose value is then replaced), without a data-dependent branch per corner.
+    const std::uint32_t o = octants[depth];
+    const float* last = blocks[depth];
+    for (std::uint32_t c = 0; c < 8; ++c) corners[c] = last[kChildCornerSlot[o][c]];
+    std::uint32_t level = depth - 1;
+    while (level > startDepth && octants[level] == o) --level;
+    if (level > startDepth) {
+      corners[o] = blocks[level][kChildCornerSlot[octants[level]][o]];
+    } else if (startDepth == 0) {
+      corners[o] = rootCorners[o];
+    } else {
+      // Corner o of the grid cell (rare: every octant below the grid equals o).
+      const std::size_t n = std::size_t{1} << gridDepth, m = n + 1;
+      const std::size_t ix = gridCell % n, iy = (gridCell / n) % n, iz = gridCell / (n * n);
+      corners[o] = gridCorners[(ix + (o & 1)) + m * ((iy + ((o >> 1) & 1)) + m * (iz + (o >> 2)))];
     }
   }
   const double cells = static_cast<double>(1u << depth);
@@ -191,8 +246,9 @@ ContactFieldSample ContactTree::sample(const Vec3& p, std::uint32_t maxDepthQuer
   }
   Vec3 gradientLocal;
   out.distance = interpolateTrilinear(corners, t, &gradientLocal);
-  out.gradient = gradientLocal * (cells / rootSize);
-  out.errorBound = errorBound[node];
+  const double cellsPerLength = cells / rootSize;
+  out.gradient = gradientLocal * cellsPerLength;
+  out.errorBound = errorBound(node, depth);
   out.node = node;
   out.depth = depth;
   if (!out.insideRoot) {

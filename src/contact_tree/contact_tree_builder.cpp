@@ -312,6 +312,7 @@ ContactTree Builder::build(ContactTreeBuildStats* stats) {
 
   std::vector<CellResult> results;
   std::vector<PendingCell> next;
+  std::vector<std::uint8_t> interior, surface;  // per node, packed into bitmaps at the end
   tree_.levelOffsets.push_back(0);
   for (std::uint32_t depth = 0; !frontier.empty(); ++depth) {
     results.assign(frontier.size(), CellResult{});
@@ -328,15 +329,14 @@ ContactTree Builder::build(ContactTreeBuildStats* stats) {
       st.distanceQueries += r.queries;
       st.measuredCells += r.measured;
       st.discontinuousCells += r.discontinuous;
-      tree_.errorBound.push_back(r.error);
-      if (r.surface) {
-        tree_.halfSpaceIndex.push_back(static_cast<std::uint32_t>(tree_.halfSpaces.size()));
-        tree_.halfSpaces.push_back(r.halfSpace);
-      } else {
-        tree_.halfSpaceIndex.push_back(kNoHalfSpace);
-      }
+      // Capped at the Lipschitz bound D/2 (ratio 1) except where the field jumps; the cap also
+      // absorbs the float rounding of r.error = D/2, which could otherwise round the code up.
+      const double ratio = double(r.error) / tree_.cellRadius(depth);
+      tree_.errorCode.push_back(ContactTree::encodeErrorRatio(r.discontinuous ? ratio : std::min(ratio, 1.0)));
+      surface.push_back(r.surface ? 1 : 0);
+      if (r.surface) tree_.halfSpaces.push_back(r.halfSpace);
+      interior.push_back(r.split ? 1 : 0);
       if (!r.split) {
-        tree_.firstChild.push_back(0);
         ++st.leaves;
         st.leavesAboveError += r.aboveError;
         if (r.measured && !r.discontinuous) st.maxBandLeafError = std::max(st.maxBandLeafError, double(r.bandError));
@@ -344,7 +344,6 @@ ContactTree Builder::build(ContactTreeBuildStats* stats) {
       }
       const std::size_t firstChild = tree_.levelOffsets.back() + frontier.size() + next.size();
       if (firstChild + 8 > 0xfffffff0u) throw Error(ErrorCode::kUnsupportedMesh, "contact tree: more than 2^32 nodes; raise errorRel or lower maxDepth");
-      tree_.firstChild.push_back(static_cast<std::uint32_t>(firstChild));
       for (int l = 0; l < kLatticeSize; ++l)
         if (kLatticeSlot[l] >= 0) tree_.lattice.push_back(r.lattice[l]);
       for (int o = 0; o < 8; ++o) {
@@ -357,6 +356,7 @@ ContactTree Builder::build(ContactTreeBuildStats* stats) {
     tree_.levelOffsets.push_back(static_cast<std::uint32_t>(tree_.levelOffsets.back() + frontier.size()));
     frontier.swap(next);
   }
+  tree_.assignNodeBits(interior, surface);
   st.nodes = tree_.nodeCount();
   st.surfaceCells = tree_.halfSpaces.size();
   if (stats) *stats = st;

@@ -99,11 +99,9 @@ inline void expectSameContactTree(const ContactTree& a, const ContactTree& b) {
   EXPECT_TRUE(sameBits(a.bandAbs, b.bandAbs));
   EXPECT_EQ(a.maxDepth, b.maxDepth);
   EXPECT_TRUE(sameBits(a.rootCorners, b.rootCorners));
-  EXPECT_EQ(a.firstChild, b.firstChild);
-  EXPECT_EQ(a.errorBound.size(), b.errorBound.size());
-  EXPECT_TRUE(a.errorBound.size() == b.errorBound.size() &&
-              std::memcmp(a.errorBound.data(), b.errorBound.data(), a.errorBound.size() * sizeof(float)) == 0);
-  EXPECT_EQ(a.halfSpaceIndex, b.halfSpaceIndex);
+  EXPECT_TRUE(a.nodeWords.size() == b.nodeWords.size() &&
+              std::memcmp(a.nodeWords.data(), b.nodeWords.data(), a.nodeWords.size() * sizeof(ContactTreeNodeWord)) == 0);
+  EXPECT_EQ(a.errorCode, b.errorCode);
   EXPECT_EQ(a.levelOffsets, b.levelOffsets);
   EXPECT_TRUE(a.lattice.size() == b.lattice.size() &&
               std::memcmp(a.lattice.data(), b.lattice.data(), a.lattice.size() * sizeof(float)) == 0);
@@ -125,6 +123,7 @@ inline void expectSameContents(const BakeContents& a, const BakeContents& b) {
   EXPECT_EQ(a.sphereTreeSettings.branching, b.sphereTreeSettings.branching);
   EXPECT_EQ(a.sphereTreeSettings.depth, b.sphereTreeSettings.depth);
   EXPECT_EQ(a.sphereTreeSettings.medialSamples, b.sphereTreeSettings.medialSamples);
+  EXPECT_EQ(a.sphereTreeSettings.medialReduction, b.sphereTreeSettings.medialReduction);
   const SphereTree& s = a.sphereTree;
   const SphereTree& t = b.sphereTree;
   EXPECT_EQ(s.centerX, t.centerX);

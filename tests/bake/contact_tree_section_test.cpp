@@ -190,7 +190,7 @@ TEST_F(BakeContactTree, EncodeRefusesATreeOfAnotherMeshOrWithBrokenInvariants) {
 
   contents.contactTree = baked_->contents.contactTree;
   ASSERT_GT(contents.contactTree->nodeCount(), 9u);
-  contents.contactTree->firstChild[0] = 2;  // children must start right after the root
+  contents.contactTree->nodeWords[0].interior &= ~std::uint64_t{1};  // a leaf root with 8 children
   EXPECT_EQ(thrownCode([&] { encodeBake(contents); }), ErrorCode::kInvalidArgument);
 
   contents.contactTree = baked_->contents.contactTree;
@@ -221,8 +221,15 @@ TEST_F(BakeContactTree, TrailingOrMissingPayloadBytesAndNewerVersionsAreRejected
   EXPECT_EQ(thrownCode([&] { decodeBake(fileWithTreePayload(baked_->contents, payload, kBakeContactTreeVersion + 1)); }),
             ErrorCode::kBakeVersion);
   std::vector<std::byte> innerNewer = payload;
-  innerNewer[0] = std::byte{2};  // the codec's own u32 version, little-endian
+  innerNewer[0] = std::byte{kContactTreeCodecVersion + 1};  // the codec's own u32 version, little-endian
   EXPECT_EQ(thrownCode([&] { decodeBake(fileWithTreePayload(baked_->contents, innerNewer)); }), ErrorCode::kBakeVersion);
+  // A file from before the bitmap encoding (codec version 1: 32-bit child indices) must not be
+  // misread as the current layout: it is refused by version, with a message saying so.
+  std::vector<std::byte> innerOld = payload;
+  innerOld[0] = std::byte{1};
+  const std::vector<std::byte> oldFile = fileWithTreePayload(baked_->contents, innerOld);
+  EXPECT_EQ(thrownCode([&] { decodeBake(oldFile); }), ErrorCode::kBakeVersion);
+  EXPECT_NE(thrownMessage(oldFile).find("version 1 is not the supported version 2"), std::string::npos) << thrownMessage(oldFile);
 }
 
 // Bytes flipped inside the payload with valid checksums (a hostile or buggy writer): every
@@ -235,7 +242,7 @@ TEST_F(BakeContactTree, ResealedPayloadFlipsAreRejectedOrGiveASafeTree) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   // Fields no valid variation of which exists for this mesh (codec layout, contact_tree_codec.h):
   // version [0,4), meshDiagonal [36,44) (tied to the mesh), maxDepth [60,64) (0x40 takes it
-  // past 20), firstChild's count [96,104) (the arrays no longer agree).
+  // past 20), levelOffsets' count [96,104) (the arrays no longer agree).
   auto mustReject = [](std::size_t at) {
     return at < 4 || (at >= 36 && at < 44) || (at >= 60 && at < 64) || (at >= 96 && at < 104);
   };
