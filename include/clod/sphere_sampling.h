@@ -186,6 +186,19 @@ private:
   std::uint32_t closestRingByFormula(double z, double rho) const noexcept;
   std::uint32_t nearestInGrid(const Vec3& u) const noexcept;        // sampling_grid.cpp
   std::uint32_t gridCell(const Vec3& u) const noexcept;
+  // The sample among `candidates` with the largest dot product with u (the nearest on the sphere).
+  std::uint32_t nearestAmong(std::span<const std::uint32_t> candidates, const Vec3& u) const noexcept {
+    std::uint32_t best = 0;
+    double bestDot = -2.0;
+    for (const std::uint32_t s : candidates) {
+      const double d = x_[s] * u.x() + y_[s] * u.y() + z_[s] * u.z();
+      if (d > bestDot) {
+        bestDot = d;
+        best = s;
+      }
+    }
+    return best;
+  }
 
   SamplingScheme scheme_ = SamplingScheme::kPolar;
   int resolution_ = 0;

@@ -31,6 +31,10 @@ void checkSphereTree(const SphereTree& tree, const SphereTreeSettings& settings,
   if (settings.method != SphereTreeMethod::kOctree && settings.method != SphereTreeMethod::kMedial) {
     complain("unknown sphere-tree method " + str(static_cast<std::uint32_t>(settings.method)));
   }
+  if (settings.medialReduction != MedialReduction::kBest && settings.medialReduction != MedialReduction::kMergeBurst &&
+      settings.medialReduction != MedialReduction::kKMeans) {
+    complain("unknown medial reduction " + str(static_cast<std::uint32_t>(settings.medialReduction)));
+  }
   const std::size_t n = tree.radius.size();
   if (n == 0) complain("the sphere-tree has no spheres");
   if (n >= kNoSphere) complain("sphere count " + str(n) + " does not fit 32 bits");
@@ -117,7 +121,8 @@ void checkSphereTree(const SphereTree& tree, const SphereTreeSettings& settings,
 std::vector<std::byte> encodeSphereTreeSection(const SphereTree& tree, const SphereTreeSettings& settings) {
   ByteWriter writer;
   writer.write<std::uint8_t>(static_cast<std::uint8_t>(settings.method));
-  writer.write<std::uint8_t>(0);
+  // Was a reserved 0 byte before the reduction was stored; 0 is kBest, the default of those builds.
+  writer.write<std::uint8_t>(static_cast<std::uint8_t>(settings.medialReduction));
   writer.write<std::uint16_t>(0);
   writer.write<std::uint32_t>(settings.branching);
   writer.write<std::uint32_t>(settings.depth);
@@ -130,7 +135,8 @@ DecodedSphereTreeSection decodeSphereTreeSection(std::span<const std::byte> payl
   ByteReader reader(payload.data(), payload.size(), "bake section 'STRE'");
   DecodedSphereTreeSection decoded;
   decoded.settings.method = static_cast<SphereTreeMethod>(reader.read<std::uint8_t>());
-  if (reader.read<std::uint8_t>() != 0 || reader.read<std::uint16_t>() != 0) reader.fail("reserved bytes after the method are not 0");
+  decoded.settings.medialReduction = static_cast<MedialReduction>(reader.read<std::uint8_t>());
+  if (reader.read<std::uint16_t>() != 0) reader.fail("reserved bytes after the medial reduction are not 0");
   decoded.settings.branching = reader.read<std::uint32_t>();
   decoded.settings.depth = reader.read<std::uint32_t>();
   decoded.settings.medialSamples = reader.read<std::uint32_t>();

@@ -43,8 +43,7 @@ int closestFeatureMapStacks(const ClosestFeatureMapSettings& settings, int level
   return halved < settings.minStacks ? settings.minStacks : halved;
 }
 
-ClosestFeatureMap ClosestFeatureMap::fromData(ClosestFeatureMapData data, const SphereTree& tree) {
-  const ClosestFeatureMapSettings& s = data.settings;
+void validateClosestFeatureMapSettings(const ClosestFeatureMapSettings& s) {
   bool knownScheme = false;
   for (SamplingScheme scheme : allSamplingSchemes()) knownScheme = knownScheme || scheme == s.scheme;
   if (!knownScheme) invalid("unknown sampling scheme " + str(static_cast<std::uint32_t>(s.scheme)));
@@ -58,6 +57,11 @@ ClosestFeatureMap ClosestFeatureMap::fromData(ClosestFeatureMapData data, const 
   if (s.minStacks < 1 || s.minStacks > s.rootStacks) {
     invalid("min stacks " + std::to_string(s.minStacks) + " outside [1, root stacks " + std::to_string(s.rootStacks) + "]");
   }
+}
+
+ClosestFeatureMap ClosestFeatureMap::fromData(ClosestFeatureMapData data, const SphereTree& tree) {
+  const ClosestFeatureMapSettings& s = data.settings;
+  validateClosestFeatureMapSettings(s);
   const std::uint32_t levels = tree.levelCount();
   const std::uint32_t spheres = tree.sphereCount();
   if (data.levelStacks.size() != levels) {

@@ -22,22 +22,6 @@ namespace {
 
 std::string str(std::uint64_t value) { return std::to_string(value); }
 
-void checkSettings(const ClosestFeatureMapSettings& s) {
-  bool knownScheme = false;
-  for (SamplingScheme scheme : allSamplingSchemes()) knownScheme = knownScheme || scheme == s.scheme;
-  if (!knownScheme) invalid("unknown sampling scheme " + str(static_cast<std::uint32_t>(s.scheme)));
-  if (s.codec != NormalCodec::kOctahedral16 && s.codec != NormalCodec::kOctahedral32) {
-    invalid("unknown normal codec " + str(static_cast<std::uint32_t>(s.codec)));
-  }
-  const int maxStacks = maxSamplingResolution(SamplingScheme::kPolar);
-  if (s.rootStacks < 1 || s.rootStacks > maxStacks) {
-    invalid("stacks " + std::to_string(s.rootStacks) + " outside [1, " + std::to_string(maxStacks) + "]");
-  }
-  if (s.minStacks < 1 || s.minStacks > s.rootStacks) {
-    invalid("min stacks " + std::to_string(s.minStacks) + " outside [1, stacks " + std::to_string(s.rootStacks) + "]");
-  }
-}
-
 void checkTree(const SphereTree& tree, std::uint32_t triangleCount) {
   const std::size_t n = tree.radius.size();
   if (n == 0 || tree.levelOffsets.size() < 2 || tree.levelOffsets.back() != n || tree.centerX.size() != n ||
@@ -76,7 +60,7 @@ Vec3 averageFaceNormal(const TriangleMesh& mesh, std::span<const std::uint32_t> 
 
 ClosestFeatureMap buildClosestFeatureMap(const MeshDistance& mesh, const SphereTree& tree,
                                          const ClosestFeatureMapSettings& settings) {
-  checkSettings(settings);
+  validateClosestFeatureMapSettings(settings);
   checkTree(tree, mesh.mesh().triangleCount());
   const std::uint32_t levels = tree.levelCount();
   const std::uint32_t spheres = tree.sphereCount();

@@ -175,17 +175,7 @@ void SphereSampling::buildGeodesic() {
 std::uint32_t SphereSampling::nearestQuadrantSearch(const Vec3& u) const noexcept {
   CLOD_ASSERT(scheme_ == SamplingScheme::kGeodesic);
   const int octant = octantOf(u);
-  std::uint32_t best = 0;
-  double bestDot = -2.0;
-  for (std::uint32_t k = octantStart_[octant]; k < octantStart_[octant + 1]; ++k) {
-    const std::uint32_t s = octantSamples_[k];
-    const double d = x_[s] * u.x() + y_[s] * u.y() + z_[s] * u.z();
-    if (d > bestDot) {
-      bestDot = d;
-      best = s;
-    }
-  }
-  return best;
+  return nearestAmong(std::span(octantSamples_).subspan(octantStart_[octant], octantStart_[octant + 1] - octantStart_[octant]), u);
 }
 
 }  // namespace clod

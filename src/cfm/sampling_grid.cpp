@@ -117,17 +117,7 @@ std::uint32_t SphereSampling::gridCell(const Vec3& u) const noexcept {
 
 std::uint32_t SphereSampling::nearestInGrid(const Vec3& u) const noexcept {
   const std::uint32_t cell = gridCell(u);
-  std::uint32_t best = 0;
-  double bestDot = -2.0;
-  for (std::uint32_t k = cellStart_[cell]; k < cellStart_[cell + 1]; ++k) {
-    const std::uint32_t s = cellSamples_[k];
-    const double d = x_[s] * u.x() + y_[s] * u.y() + z_[s] * u.z();
-    if (d > bestDot) {
-      bestDot = d;
-      best = s;
-    }
-  }
-  return best;
+  return nearestAmong(std::span(cellSamples_).subspan(cellStart_[cell], cellStart_[cell + 1] - cellStart_[cell]), u);
 }
 
 }  // namespace clod

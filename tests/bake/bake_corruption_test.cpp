@@ -143,6 +143,16 @@ TEST(BakeCorruption, UnknownSphereTreeMethodIsCorruption) {
   expectCorruptMentioning(writer.encode(), "method");
 }
 
+TEST(BakeCorruption, UnknownMedialReductionIsCorruption) {
+  BakeContents contents = makeTestContents();
+  BakeFileWriter writer;
+  writer.addSection(kBakeMeshTag, kBakeMeshVersion, detail::encodeMeshSection(contents.mesh, meshContentHash(contents.mesh), ""));
+  contents.sphereTreeSettings.medialReduction = static_cast<MedialReduction>(3);
+  writer.addSection(kBakeSphereTreeTag, kBakeSphereTreeVersion,
+                    detail::encodeSphereTreeSection(contents.sphereTree, contents.sphereTreeSettings));
+  expectCorruptMentioning(writer.encode(), "medial reduction");
+}
+
 TEST(BakeCorruption, BrokenMeshInvariantsAreCorruptionNamingTheCulprit) {
   const BakeContents contents = makeTestContents();
   auto fileWithMesh = [&](const TriangleMesh& mesh, std::uint64_t hash) {

@@ -37,6 +37,7 @@ TEST(BakeRoundTrip, SpecialValuesSurviveBitExactly) {
   contents.sphereTree.radius.back() = 0.0;
   contents.sourceName = std::string("n\0l\xff", 4);  // arbitrary bytes, not just text
   contents.sphereTreeSettings = {SphereTreeMethod::kMedial, 3, 9, 4321};
+  contents.sphereTreeSettings.medialReduction = MedialReduction::kKMeans;
   const BakeContents decoded = decodeBake(encodeBake(contents));
   contents.meshHash = meshContentHash(contents.mesh);
   expectSameContents(contents, decoded);

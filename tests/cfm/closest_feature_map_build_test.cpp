@@ -21,14 +21,12 @@
 #include "clod/primitives.h"
 #include "clod/proximity.h"
 #include "clod/sphere_tree_builder.h"
+#include "support/test_scale.h"
 
 namespace clod {
 namespace {
 
-bool sanitizerRun() {
-  const char* scale = std::getenv("CLOD_TEST_SCALE");
-  return scale != nullptr && std::strcmp(scale, "sanitizer") == 0;
-}
+using test::sanitizerRun;
 
 TriangleMesh sharedMesh(const char* name) { return loadMesh(std::filesystem::path(CLOD_SHARED_MESH_DIR) / name).mesh; }
 
@@ -106,6 +104,8 @@ BuiltCase buildCase(TriangleMesh mesh, SphereTreeMethod method, const ClosestFea
   SphereTreeSettings treeSettings;
   treeSettings.method = method;
   treeSettings.medialSamples = 3000;
+  // Under sanitizers one level less (an eighth of the spheres to map): every code path stays.
+  if (sanitizerRun()) treeSettings.depth = 3;
   SphereTree tree = buildSphereTree(distance, treeSettings);
   ClosestFeatureMap maps = buildClosestFeatureMap(distance, tree, settings);
   return {std::move(mesh), std::move(tree), std::move(maps)};

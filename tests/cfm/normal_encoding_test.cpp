@@ -9,15 +9,13 @@
 #include <string>
 
 #include "clod/normal_encoding.h"
+#include "support/test_scale.h"
 
 namespace {
 
 using clod::Vec3;
 
-bool sanitizerRun() {
-  const char* scale = std::getenv("CLOD_TEST_SCALE");
-  return scale != nullptr && std::string(scale) == "sanitizer";
-}
+using clod::test::sanitizerRun;
 
 double angle(const Vec3& a, const Vec3& b) {
   // atan2 form: accurate for tiny angles, where acos of a dot product loses half the digits.

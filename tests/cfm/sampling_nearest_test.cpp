@@ -10,6 +10,7 @@
 
 #include "clod/sampling_statistics.h"
 #include "clod/sphere_sampling.h"
+#include "support/test_scale.h"
 
 namespace {
 
@@ -17,10 +18,7 @@ using clod::SamplingScheme;
 using clod::SphereSampling;
 using clod::Vec3;
 
-bool sanitizerRun() {
-  const char* scale = std::getenv("CLOD_TEST_SCALE");
-  return scale != nullptr && std::string(scale) == "sanitizer";
-}
+using clod::test::sanitizerRun;
 
 // The issue asks for 10^5 random directions per (scheme, resolution). Under ASan+UBSan the
 // brute-force oracle over up to 4000 samples dominates; 2000 directions keep it within budget.

@@ -1,42 +1,16 @@
 // `clod inspect` as external checks use it: run the built CLI, parse its JSON, check exit codes.
 // Expected values come from the shared meshes' README and from the box test file's geometry.
-#include <sys/wait.h>
-
-#include <array>
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cli/cli_runner.h"
+
 namespace {
 
-struct CliRun {
-  int exitCode = -1;
-  std::string out;
-  std::string err;
-};
-
-// Runs `clod <args>` with stdout captured through popen and stderr through a temporary file.
-CliRun runCli(const std::string& args) {
-  const std::filesystem::path errPath =
-      std::filesystem::temp_directory_path() / ("clod_inspect_test_" + std::to_string(::getpid()) + ".err");
-  const std::string command = std::string("\"") + CLOD_CLI_PATH + "\" " + args + " 2>\"" + errPath.string() + "\"";
-  CliRun run;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return run;
-  std::array<char, 4096> buffer;
-  std::size_t n;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.out.append(buffer.data(), n);
-  const int status = ::pclose(pipe);
-  run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  std::ifstream err(errPath);
-  run.err.assign(std::istreambuf_iterator<char>(err), std::istreambuf_iterator<char>());
-  std::filesystem::remove(errPath);
-  return run;
-}
+using clod::test::CliRun;
+using clod::test::runCli;
 
 std::string quoted(const std::string& path) { return "\"" + path + "\""; }
 std::string sharedMesh(const char* name) { return quoted(std::string(CLOD_SHARED_MESH_DIR) + "/" + name); }

@@ -12,18 +12,13 @@
 #include <vector>
 
 #include "clod/mesh.h"
+#include "support/test_scale.h"
 
 namespace clod::test {
 
 inline std::string goodFile(const std::string& name) { return std::string(CLOD_TEST_DATA_DIR) + "/good/" + name; }
 inline std::string badFile(const std::string& name) { return std::string(CLOD_TEST_DATA_DIR) + "/bad/" + name; }
 inline std::string sharedMesh(const std::string& name) { return std::string(CLOD_SHARED_MESH_DIR) + "/" + name; }
-
-/// True in the sanitizer CI run, where sample counts may be reduced.
-inline bool sanitizerRun() {
-  const char* scale = std::getenv("CLOD_TEST_SCALE");
-  return scale && std::strcmp(scale, "sanitizer") == 0;
-}
 
 /// Brute-force edge use counts: undirected edge (min, max) -> number of triangle sides on it.
 inline std::map<std::pair<std::uint32_t, std::uint32_t>, int> countEdgeUses(const TriangleMesh& mesh) {

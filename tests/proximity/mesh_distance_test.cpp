@@ -125,7 +125,7 @@ std::vector<Vec3> samplePoints(const TriangleMesh& mesh, int boxCount, int nearC
   return points;
 }
 
-int scaled(int full, int sanitizer) { return oracle::sanitizerScale() ? sanitizer : full; }
+int scaled(int full, int sanitizer) { return oracle::sanitizerRun() ? sanitizer : full; }
 
 class MeshDistanceOnCorpus : public ::testing::TestWithParam<NamedMesh> {};
 

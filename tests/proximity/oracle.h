@@ -20,17 +20,14 @@
 #include "clod/math.h"
 #include "clod/mesh.h"
 #include "clod/proximity.h"
+#include "support/test_scale.h"
 
 namespace oracle {
 
 using clod::FeatureType;
 using clod::Vec3;
 
-/// True in the ASan/UBSan CI run, where sample counts are reduced.
-inline bool sanitizerScale() {
-  const char* scale = std::getenv("CLOD_TEST_SCALE");
-  return scale && std::string(scale) == "sanitizer";
-}
+using clod::test::sanitizerRun;
 
 struct Hit {
   Vec3 point;

@@ -44,7 +44,7 @@ TEST(TriangleClosestPoint, MatchesProjectionOracleOnRandomAndDegenerateTriangles
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(-1, 1);
   auto rv = [&] { return Vec3(u(rng), u(rng), u(rng)); };
-  const int trials = oracle::sanitizerScale() ? 20000 : 200000;
+  const int trials = oracle::sanitizerRun() ? 20000 : 200000;
   int featureMismatches = 0;
   for (int i = 0; i < trials; ++i) {
     Vec3 a = rv(), b = rv(), c = rv();

@@ -4,6 +4,7 @@
 // the level's spheres. No tolerance: the builders promise exact coverage.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "clod/mesh_io.h"
@@ -29,8 +30,12 @@ void expectEveryLevelCovers(const SphereTree& tree, const std::vector<Vec3>& poi
 
 // Octree, the default medial builder (per node the better of merge/burst and k-means) and the
 // merge/burst reduction alone (with fewer medial samples: coverage does not depend on them, and
-// it keeps the runner short).
+// it keeps the runner short). Under sanitizers the trees stop one level earlier and the medial
+// sampling is sparser: every builder and reduction still runs (the default runs merge/burst on
+// every node), at an eighth of the leaves.
 void checkBothBuilders(const TriangleMesh& mesh, std::size_t sampleCount, bool mergeBurstAlone = true) {
+  const bool reduced = test::sanitizerRun();
+  if (reduced) mergeBurstAlone = false;
   const MeshDistance distance(mesh);
   const std::vector<Vec3> points = test::sampleSurfaceUniformly(mesh, sampleCount, 20260521);
   struct Case {
@@ -48,7 +53,8 @@ void checkBothBuilders(const TriangleMesh& mesh, std::size_t sampleCount, bool m
     SphereTreeSettings settings;  // defaults: 8-ary, 4 levels below the root
     settings.method = c.method;
     settings.medialReduction = c.reduction;
-    settings.medialSamples = c.medialSamples;
+    settings.medialSamples = reduced ? std::min<std::uint32_t>(c.medialSamples, 3000) : c.medialSamples;
+    if (reduced) settings.depth = 3;
     const SphereTree tree = buildSphereTree(distance, settings);
     test::expectWellFormedTree(tree, distance.mesh(), settings);
     expectEveryLevelCovers(tree, points);
@@ -59,11 +65,14 @@ class SharedMeshSphereTrees : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(SharedMeshSphereTrees, BothBuildersCoverEveryLevelAndKeepTheTreeInvariants) {
   const std::string name = GetParam();
-  if (test::sanitizerScale() && name == "stanford-bunny.obj") GTEST_SKIP() << "69k triangles: Release run only";
+  if (test::sanitizerRun() && name == "stanford-bunny.obj") GTEST_SKIP() << "69k triangles: Release run only";
+  // Closed smooth meshes add no code path under sanitizers that fandisk (closed, sharp), rocker-arm
+  // (genus > 0), teapot, suzanne and bunny-1500 (open, non-manifold) do not already take.
+  if (test::sanitizerRun() && (name == "spot.obj" || name == "cow.obj")) GTEST_SKIP() << "Release run only";
   const LoadedMesh loaded = loadMesh(std::filesystem::path(CLOD_SHARED_MESH_DIR) / name);
   // The 69k-triangle bunny checks the default builders only (its default medial build runs the
   // merge/burst reduction on every node already), to keep the runner short.
-  checkBothBuilders(loaded.mesh, test::sanitizerScale() ? 5000 : 50000, name != "stanford-bunny.obj");
+  checkBothBuilders(loaded.mesh, test::sanitizerRun() ? 5000 : 50000, name != "stanford-bunny.obj");
 }
 
 INSTANTIATE_TEST_SUITE_P(Corpus, SharedMeshSphereTrees,
@@ -72,7 +81,7 @@ INSTANTIATE_TEST_SUITE_P(Corpus, SharedMeshSphereTrees,
                          test::meshParamName);
 
 TEST(PrimitiveSphereTrees, BothBuildersCoverBoxesIcospheresAndCylinders) {
-  const std::size_t samples = test::sanitizerScale() ? 3000 : 20000;
+  const std::size_t samples = test::sanitizerRun() ? 3000 : 20000;
   {
     SCOPED_TRACE("flat box");
     checkBothBuilders(makeBox(Vec3(2.0, 1.0, 0.05)), samples);

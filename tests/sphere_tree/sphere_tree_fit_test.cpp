@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <string>
 
 #include "clod/error.h"
 #include "clod/mesh_io.h"
@@ -134,11 +135,15 @@ class ClosedMeshFit : public ::testing::TestWithParam<const char*> {};
 TEST_P(ClosedMeshFit, MedialFitsTighterThanOctreeOnEveryLevelBelowTheRoot) {
   // Oracle: measureSphereTreeFit, which measures every sphere against the exact closest points
   // of its triangles (MeshDistance) and shares no code with either builder's own fit estimate.
-  const LoadedMesh loaded = loadMesh(std::filesystem::path(CLOD_SHARED_MESH_DIR) / GetParam());
+  // Under sanitizers one mesh of each kind: fandisk (sharp CAD) and spot (smooth) take every code
+  // path of both builders and of the fit measurement.
+  const std::string name = GetParam();
+  if (test::sanitizerRun() && name != "fandisk.obj" && name != "spot.obj") GTEST_SKIP() << "Release run only";
+  const LoadedMesh loaded = loadMesh(std::filesystem::path(CLOD_SHARED_MESH_DIR) / name);
   const MeshDistance distance(loaded.mesh);
   SphereTreeSettings settings;  // 8-ary, 4 levels below the root, as in the issue
   SphereFitSettings fitSettings;
-  if (test::sanitizerScale()) {
+  if (test::sanitizerRun()) {
     settings.medialSamples = 5000;
     fitSettings.samplesPerSphere = 40;
   }
@@ -153,11 +158,11 @@ TEST_P(ClosedMeshFit, MedialFitsTighterThanOctreeOnEveryLevelBelowTheRoot) {
         << "level " << l << ": medial " << medial[l].spheres << " spheres, octree " << octree[l].spheres;
     // The issue asks for the mean at least and aims for the max too; with the default settings
     // the medial builder wins both on these meshes, so the full-scale run holds it to that.
-    if (!test::sanitizerScale()) {
+    if (!test::sanitizerRun()) {
       EXPECT_LT(medial[l].fitMax, octree[l].fitMax) << "level " << l;
     }
   }
-  if (test::sanitizerScale()) return;  // the default above already runs the merge/burst code
+  if (test::sanitizerRun()) return;  // the default above already runs the merge/burst code
   // Bradshaw's merge/burst reduction on its own beats the octree on the mean fit of every level.
   // (Not on the max: alone it leaves a few loose spheres deep down, e.g. on spot's level 4;
   // docs/benchmarks/sphere_tree.md has the figures.)

@@ -13,14 +13,9 @@
 
 #include "clod/mesh.h"
 #include "clod/sphere_tree.h"
+#include "support/test_scale.h"
 
 namespace clod::test {
-
-/// True in the ASan+UBSan run (CLOD_TEST_SCALE=sanitizer), where sample counts are reduced.
-inline bool sanitizerScale() {
-  const char* scale = std::getenv("CLOD_TEST_SCALE");
-  return scale != nullptr && std::strcmp(scale, "sanitizer") == 0;
-}
 
 /// Test name for a mesh file parameter: "rocker-arm.obj" -> "rocker_arm".
 inline std::string meshParamName(const ::testing::TestParamInfo<const char*>& param) {
