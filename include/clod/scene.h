@@ -6,6 +6,7 @@
 // Top-level keys (all optional except bodies): "gravity" [x,y,z] (default [0,0,-9.81]),
 // "dt" (s, default 1/60), "steps" or "duration" (s; default 120 steps), "contact_model"
 // (contact.h names, default "cfm"), "budget" (tests per frame, 0 = unlimited), "max_contacts",
+// "min_substeps" (WorldSettings::minSubsteps, default 1; tall stacks need ~8),
 // "bounds" {"min": [..], "max": [..]}, "bodies" [ ... ]. Body keys: "name", exactly one of
 // "mesh" (path relative to the scene file), "box" [hx,hy,hz] (half extents) or "sphere" r;
 // "position", "orientation" [w,x,y,z], "velocity", "angular_velocity", "density" or "mass"

@@ -149,7 +149,7 @@ SceneDescription parseScene(std::string_view text, const std::filesystem::path& 
   } catch (const Json::parse_error& e) {
     throw Error(ErrorCode::kSceneError, fileName + ": not valid JSON: " + e.what());
   }
-  r.object(j, "", {"gravity", "dt", "steps", "duration", "contact_model", "budget", "max_contacts", "bounds", "bodies"});
+  r.object(j, "", {"gravity", "dt", "steps", "duration", "contact_model", "budget", "max_contacts", "min_substeps", "bounds", "bodies"});
   SceneDescription s;
   if (j.contains("gravity")) s.world.gravity = r.vec<3>(j["gravity"], "gravity");
   if (j.contains("dt")) s.dt = r.positive(j["dt"], "dt");
@@ -171,6 +171,8 @@ SceneDescription parseScene(std::string_view text, const std::filesystem::path& 
   }
   if (j.contains("budget")) s.world.budgetTests = r.count(j["budget"], "budget", 0, std::uint64_t(1) << 40);
   if (j.contains("max_contacts")) s.world.maxContacts = std::uint32_t(r.count(j["max_contacts"], "max_contacts", 1, 1024));
+  if (j.contains("min_substeps"))
+    s.world.minSubsteps = std::uint32_t(r.count(j["min_substeps"], "min_substeps", 1, s.world.maxSubsteps));
   if (j.contains("bounds")) {
     r.object(j["bounds"], "bounds", {"min", "max"});
     if (!j["bounds"].contains("min") || !j["bounds"].contains("max")) r.fail("bounds", "needs \"min\" and \"max\"");
