@@ -12,7 +12,11 @@
 //      budget division among the candidate pairs (below); narrow phase (queryContacts) per pair;
 //      velocity solve (normal + 2 friction directions per contact, accumulated impulses clamped,
 //      warm started from the previous substep's contacts of the same pair, matched one-to-one by
-//      proximity and normal; pairs solved in a fixed order of body ids);
+//      proximity and normal; pairs solved in a fixed order of body ids). Contacts persist: each is
+//      anchored in both bodies, a matched one keeps its anchors while they have not slid or opened
+//      by more than 1 % of the smaller diagonal, and every point's separation is measured from its
+//      anchors each substep (per-point depth; open points are speculative: the solve lets them
+//      approach by separation / h);
 //      restitution only above WorldSettings::restitutionThreshold; penetration removed by a
 //      separate pseudo-velocity solve (split impulses) that moves positions but never enters the
 //      velocities, so correction adds no kinetic energy; integration (semi-implicit Euler for

@@ -337,12 +337,14 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance) {
       // Warm start only resting contact: re-applying last substep's impulse to a pair that is now
       // separating or approaching fast (a bounce) adds energy the iterations may not remove.
       const bool resting = std::abs(vn) < s.restitutionThreshold;
-      if (!resting) cp.lambdaN = 0.0;
+      // (The impulses come from persistContacts for a queried pair, from the contact itself for
+      // a pair the budget skipped; the friction impulse is kept as a world vector because the
+      // tangent directions follow the normal.)
       if (resting) {
         cp.lambdaT1 = cp.frictionImpulse.dot(cp.t1);
         cp.lambdaT2 = cp.frictionImpulse.dot(cp.t2);
       } else {
-        cp.lambdaT1 = cp.lambdaT2 = 0.0;
+        cp.lambdaN = cp.lambdaT1 = cp.lambdaT2 = 0.0;
       }
       cp.lambdaP = 0.0;
     }
@@ -354,15 +356,17 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance) {
 
 // Persistent contacts (as Bullet's persistent manifold and Box2D's contact ids do it): each new
 // contact of a freshly queried pair is matched one-to-one to the nearest unclaimed previous
-// contact of the pair with nearly the same normal and the same level. A match passes on its
-// accumulated normal and friction impulses (warm starting) and, while its two anchors have
-// neither slid apart nor opened by more than kAnchorDriftRel of the smaller diagonal, its
-// anchors too: the point stays where it was first found on both bodies, so its separation is
-// measured from the bodies' motion since then, point by point. That is what the narrow phase
-// cannot give the exact model, whose contacts share one pair-wide depth: a box that tilts on
-// another gets deeper anchors on one side and shallower (or open, speculative) ones on the
-// other, so the position correction rights it, and the velocity solve lets the open side come
-// down. A new contact without a match is anchored at its point, half its depth into each body.
+// contact of the pair within 5 % of the smaller diagonal whose normal is within ~18 degrees. A
+// match passes on its accumulated normal and friction impulses (warm starting) and -- if it came
+// from the same narrow-phase level and its two anchors have neither slid apart nor opened by more
+// than kAnchorDriftRel of the smaller diagonal -- its anchors too: the point stays where it was
+// first found on both bodies, so its separation is measured from the bodies' motion since then,
+// point by point. That is a per-point depth the exact model, whose contacts share one pair-wide
+// depth, cannot give: a box that tilts on another gets deeper anchors on one side and shallower
+// (or open, speculative) ones on the other, so the correction acts on the deeper side and the
+// velocity solve lets the open side come down. A new contact without a match is anchored at its
+// point, half its depth into each body. (A coarser or finer level re-anchors: its depth means
+// something else.)
 void World::Impl::persistContacts(PairState& p, const Body& a, const Body& b, double diag) {
   const double matchDistance = 0.05 * diag;
   const double drift = kAnchorDriftRel * diag;

@@ -118,15 +118,6 @@ TEST(World, BoxDroppedFlatComesToRestFlatWithEveryModelAndBudget) {
   const auto slab = bakeShape(makeBox(Vec3(2.0, 2.0, 0.25)));
   for (ContactModel model : {ContactModel::kCfm, ContactModel::kContactTree, ContactModel::kExact}) {
     for (std::uint64_t budget : {std::uint64_t(16), std::uint64_t(64), std::uint64_t(256), std::uint64_t(0)}) {
-      // Known failure of the narrow phase (docs/dynamics.md): at 16 tests per frame the
-      // contact-tree query never gets below coarse cells, whose contacts let the box come to rest
-      // (v = 0) 33.7 degrees tilted and 0.18 m deep in the slab (z 0.573) -- a resting tilted box
-      // is only possible with wrong contact normals/points. Reported, not hidden.
-      if (model == ContactModel::kContactTree && budget == 16) continue;
-      // Known failure of the narrow phase, being fixed there (docs/dynamics.md): cfm at 16 tests
-      // rests 8.1 degrees tilted (limit 1); the maps' normals of sphere pairs over the box edges
-      // are side-face normals (docs/narrow-phase.md). 64, 256 and unlimited pass.
-      if (model == ContactModel::kCfm && budget == 16) continue;
       WorldSettings ws;
       ws.model = model;
       ws.budgetTests = budget;
@@ -265,6 +256,20 @@ TEST(World, BadBodyAndStepArgumentsThrowInvalidArgument) {
   b.restitution = 2.0;
   EXPECT_THROW(world.addBody(b), Error);
   EXPECT_THROW(world.step(0.0), Error);
+}
+
+TEST(World, MinSubstepsOutsideOneToMaxSubstepsThrowsInvalidArgument) {
+  WorldSettings ws;
+  ws.minSubsteps = 0;
+  EXPECT_THROW(World{ws}, Error);
+  ws.minSubsteps = ws.maxSubsteps + 1;
+  EXPECT_THROW(World{ws}, Error);
+  ws.minSubsteps = 3;
+  World world(ws);
+  RigidBodyDesc b = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
+  world.addBody(b);
+  // A body at rest in free fall would need one substep; the setting asks for three.
+  EXPECT_EQ(world.step(1.0 / 60.0).substeps, 3u);
 }
 
 TEST(World, BudgetBoundsTheTestsOfEveryFrame) {
