@@ -35,11 +35,13 @@ struct ContactSamplingSettings {
   /// Keep samples whose distance to the other body is <= marginAbs (body units, >= 0):
   /// speculative contacts for bodies about to touch. 0 keeps touching and penetrating ones.
   double marginAbs = 0.0;
-  /// Upper limit of samples per axis of a cell's half-plane: spacing = cellSize / n, where
-  /// n = clamp(cellSize / (4 eps_s), 1, samplesPerCellAxis) -- no two samples closer than the
+  /// Upper limit of samples per axis of a cell's half-plane: spacing = h / n, where h is the
+  /// smaller of the two cells' sizes (samples only count inside both, so a large cell against a
+  /// small one still puts about n x n samples into the small one) and
+  /// n = clamp(h / (4 eps_s), 1, samplesPerCellAxis) -- no two samples closer than the
   /// field can tell apart. 1..16.
   std::uint32_t samplesPerCellAxis = 4;
-  /// Also sample a layer offSurfaceDepthRel * cellSize below the half-plane (inside the
+  /// Also sample a layer offSurfaceDepthRel * h (h as above) below the half-plane (inside the
   /// sampled body), so bodies whose surfaces have passed through each other still get
   /// contacts. 0 disables it. 0..1.
   double offSurfaceDepthRel = 0.5;

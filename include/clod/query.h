@@ -91,8 +91,10 @@ struct FrontierPair {
 
 /// Result of queryContacts. Reuse one object across queries: its vectors keep their capacity.
 struct QueryResult {
-  /// Sphere models: the frontier is non-empty. Contact tree: at least one contact. Exact: a
-  /// triangle pair intersects (or, if interrupted, some frontier pair was not refuted).
+  /// dos and average: the frontier is non-empty. cfm: at least one contact (pairs whose patches
+  /// a separating axis proves apart give none, docs/narrow-phase.md). Contact tree: at least one
+  /// contact. Exact: a triangle pair intersects (or, if interrupted, some frontier pair was not
+  /// refuted).
   bool colliding = false;
   /// The manifold, at most QuerySettings::maxContacts contacts, deepest first.
   std::vector<Contact> contacts;

@@ -92,23 +92,39 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
   const ContactHalfSpace* hs = treeS.halfSpace(cellS.node);
   if (!hs) return;
   const double h = treeS.cellSize(cellS.depth);
+  const double hO = treeO.cellSize(cellO.depth);
   const Vec3 n(hs->normal[0], hs->normal[1], hs->normal[2]);
   const Vec3 onPlane = treeS.cellCenter(cellS) + double(hs->offset) * n;
   const Vec3 u = n.cross(std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).normalized();
   const Vec3 v = n.cross(u);
-  // No two samples closer than 4 eps_s: the field cannot tell such points apart.
-  const double perAxis = std::clamp(std::floor(h / (4.0 * treeS.errorAbs)), 1.0, double(settings.samplesPerCellAxis));
-  const double spacing = h / perAxis;
-  // The plane meets the cube within a disc of radius half the diagonal around onPlane.
-  const int reach = static_cast<int>(std::ceil(0.8660254037844386 * h / spacing));
+  // Samples only count inside both cells, so the spacing follows the smaller one: a coarse
+  // cell of a large flat body against a small body's cell (an interrupted query's frontier, a
+  // big flat leaf against a small one) would otherwise put only a sample or two into the small
+  // cell, all on one side of the small body (a box dropped on a slab at 16 tests got its first
+  // contacts under one quarter of its face and tipped over). No two samples closer than 4 eps_s:
+  // the field cannot tell such points apart.
+  const double hMin = std::min(h, hO);
+  const double perAxis = std::clamp(std::floor(hMin / (4.0 * treeS.errorAbs)), 1.0, double(settings.samplesPerCellAxis));
+  const double spacing = hMin / perAxis;
+  // The plane meets the smaller cell within a disc of radius half its diagonal around the
+  // projection of its centre (samples stay on a lattice anchored at onPlane, the same for every
+  // partner cell of cellS).
+  const double radiusMin = 0.8660254037844386 * hMin;
+  int i0 = 0, j0 = 0;
+  if (hO < h) {
+    const Vec3 centreO = xfWorldFromS.applyInverse(xfWorldFromO.apply(treeO.cellCenter(cellO)));
+    i0 = static_cast<int>(std::lround(u.dot(centreO - onPlane) / spacing));
+    j0 = static_cast<int>(std::lround(v.dot(centreO - onPlane) / spacing));
+  }
+  const int reach = static_cast<int>(std::ceil(radiusMin / spacing)) + 1;
   const Vec3 normalWorldS = xfWorldFromS.rotation * n;
   const double conflictCos = std::cos(settings.normalConflictDeg * kPi / 180.0);
   const bool flatS = double(hs->fitError) <= kFlatFitRel * h;
   const int layers = settings.offSurfaceDepthRel > 0.0 ? 2 : 1;
   for (int layer = 0; layer < layers; ++layer) {
-    const Vec3 layerOrigin = onPlane - (layer * settings.offSurfaceDepthRel * h) * n;
-    for (int i = -reach; i <= reach; ++i) {
-      for (int j = -reach; j <= reach; ++j) {
+    const Vec3 layerOrigin = onPlane - (layer * settings.offSurfaceDepthRel * hMin) * n;
+    for (int i = i0 - reach; i <= i0 + reach; ++i) {
+      for (int j = j0 - reach; j <= j0 + reach; ++j) {
         const Vec3 pS = layerOrigin + (i * spacing) * u + (j * spacing) * v;
         if (!insideCell(treeS, cellS, pS)) continue;
         const Vec3 pWorld = xfWorldFromS.apply(pS);

@@ -133,7 +133,7 @@ struct QueryScratch::Impl {
   std::vector<std::array<std::uint32_t, 2>> volumePairs;
   std::vector<std::uint32_t> clippers;
   std::vector<Vec3> poly, polyTmp;
-  std::vector<Contact> raw, apart;
+  std::vector<Contact> raw;
   std::vector<ContactPoint> sampled;
   std::vector<double> manifold;
 };
@@ -345,11 +345,14 @@ DosContact dosContact(const Vec3& cA, double rA, const Vec3& cB, double rB) {
 // centre toward A's); A's outward normal should face B (n_A . u < 0), B's should face A.
 //  1. if they agree (n_B and -n_A within 10 deg), n = normalize(n_B - n_A): both surfaces'
 //     normals; for face-on-face n_A = -n_B so n = n_B, on smooth bodies their average;
-//  2. if both spheres are faceted patches (CollisionBody::spherePatchVertices), the separating-
-//     axis choice of leastOverlapNormal below: the candidate (both patches' face normals and
-//     edge-edge cross products; map pseudonormals are no SAT axes and were measured to undercut
-//     the face normal where an edge of A lies along an edge of B) along which the patches overlap least, ignoring axes along which they are
-//     apart; where every axis separates them, the rules below;
+//  2. if at least one sphere is a faceted patch (CollisionBody::spherePatchVertices), the
+//     separating-axis choice of leastOverlapNormal below: the candidate (the faceted patches'
+//     face normals; edge-edge cross products when both are faceted; both map normals when one
+//     side is a curved patch bounded by its sphere -- between two faceted patches map
+//     pseudonormals are no SAT axes and were measured to undercut the face normal where an edge
+//     of A lies along an edge of B) along which the two sides overlap least; an axis along
+//     which they do not overlap proves the pair apart, and it gives no contact;
+//  rules 3-5 decide between two curved patches:
 //  3. if exactly one of them faces the other sphere, it wins: the other sphere's lookup found
 //     a feature that turns away from the contact (a loose sphere whose nearest surface is a side
 //     face, not the one touching);
@@ -359,6 +362,7 @@ DosContact dosContact(const Vec3& cA, double rA, const Vec3& cB, double rB) {
 //  5. otherwise the one that faces the other sphere more (larger n_B . u or -n_A . u): of two
 //     faces of a box meeting another box, the one turned toward the contact.
 // (A vanishing rule-1 normal, n_A = n_B, gives the D&O normal.)
+// Where a side is faceted, depth and point then come from the patches too (patchDepthAndPoint).
 constexpr double kAgreeCos = 0.984807753012208;   // cos 10 deg
 constexpr double kFaceMatchCos = 0.99939082701909; // cos 2 deg: above the 16-bit codec's ~0.95 deg
 
@@ -381,33 +385,53 @@ double patchSupport(const CollisionBody& body, std::uint32_t sphere, const Vec3&
   return support;
 }
 
-// Separating-axis choice for two faceted patches (both spheres have face normals and vertex
-// lists): among the face normals of both patches (B's, and A's negated, all as B -> A), the
-// cross products of their body-edge directions (edge-edge axes) -- the candidate axes of the
-// separating-axis test for convex polyhedra -- the direction along which the patches' projections overlap least,
-// overlap(n) = support_B(n) - (-support_A(-n)). This is the SAT's minimum-penetration axis
-// (Gottschalk et al. 1996 use the same test for OBBs): for a face resting on a face it is the
-// face normal, whatever the spheres' centre line; where an edge of A crosses an edge of B both
-// maps may return side faces, but along a side face the other patch overlaps by about its
-// sphere's radius, along the resting face only by the penetration. Axes with a negative overlap
-// are skipped: along them these two patches are apart, the sphere pair's overlap is the spheres'
-// looseness (a side face of A next to a side face of B), and pushing along such an axis would
-// slide the bodies sideways; the axis of least positive overlap is the one they are pressed
-// along. Returns false when a patch is not faceted (curved, or too many vertices) or every axis
-// separates: then the lookup rules decide.
-PatchAxis leastOverlapNormal(const CollisionBody& bodyA, std::uint32_t sa, const CollisionBody& bodyB,
-                             std::uint32_t sb, const Pose& xfAFromB, const Eigen::Matrix3d& rotAFromB, Vec3& best) {
-  if (bodyA.spherePatchVertices(sa).empty() || bodyB.spherePatchVertices(sb).empty()) return PatchAxis::kNotFaceted;
+// One side of a sphere pair as a support function in A's frame: the faceted patch of the sphere
+// (its vertices, CollisionBody::spherePatchVertices) when it has one, else the sphere itself,
+// which bounds whatever surface the sphere is responsible for. Both are conservative: they
+// contain that surface, so an axis along which two sides do not overlap proves that the two
+// spheres' triangles do not meet.
+struct PatchSide {
+  const CollisionBody& body;
+  std::uint32_t sphere;
+  bool faceted;
+  Vec3 centre;                    // sphere centre, A frame
+  double radius;
+  const Eigen::Matrix3d* rotToA;  // body frame -> A frame (null: body A itself)
+  Vec3 shift;                     // translation body frame -> A frame
+
+  // max over the side of n . x, n in A's frame.
+  double support(const Vec3& n) const {
+    if (!faceted) return n.dot(centre) + radius;
+    const Vec3 nLocal = rotToA ? Vec3(rotToA->transpose() * n) : n;
+    return patchSupport(body, sphere, nLocal) + n.dot(shift);
+  }
+};
+
+// Separating-axis choice between two sphere patches of which at least one is faceted. Candidate
+// axes: the face normals of the faceted patches (B's, and A's, tried both ways), the cross
+// products of their body-edge directions when both are faceted (edge-edge axes), and, when one
+// side is not faceted (a curved patch bounded by its sphere), the closest-feature-map normals of
+// both spheres (nA, nB, B -> A): a sphere at a box edge is pushed along the edge's rounding, not
+// along one of the faces. These are the candidate axes of the separating-axis test for convex
+// polyhedra (Gottschalk et al. 1996 use the same test for OBBs). The chosen axis is the one
+// along which the two sides overlap least, overlap(n) = support_B(n) - (-support_A(-n)): for a
+// face resting on a face it is the face normal, whatever the spheres' centre line; where an
+// edge of A crosses an edge of B both maps may return side faces, but along a side face the
+// other patch overlaps by about its sphere's radius, along the resting face only by the
+// penetration; a small body's sphere inside a large flat body's root sphere (a box on a floor)
+// is pushed along the floor's top face, where the centre line is nearly horizontal. Axes with a
+// negative overlap prove the sides apart (kApart): the sphere pair's overlap is looseness.
+PatchAxis leastOverlapNormal(const PatchSide& sideA, const PatchSide& sideB, const Eigen::Matrix3d& rotAFromB,
+                             const Vec3& nA, const Vec3& nB, Vec3& best) {
+  if (!sideA.faceted && !sideB.faceted) return PatchAxis::kNotFaceted;
   double bestOverlap = std::numeric_limits<double>::infinity();
   bool apart = false;
   auto consider = [&](const Vec3& n) {  // n in A's frame; both n and -n are tried
     if (apart) return;  // one separating axis settles it
-    const Vec3 nInB = rotAFromB.transpose() * n;
-    const double shift = n.dot(xfAFromB.translation);
-    const double maxB = patchSupport(bodyB, sb, nInB) + shift;
-    const double minB = -patchSupport(bodyB, sb, -nInB) + shift;
-    const double maxA = patchSupport(bodyA, sa, n);
-    const double minA = -patchSupport(bodyA, sa, -n);
+    const double maxB = sideB.support(n);
+    const double minB = -sideB.support(-n);
+    const double maxA = sideA.support(n);
+    const double minA = -sideA.support(-n);
     const double alongN = maxB - minA;   // push A along +n by this much to separate
     const double againstN = maxA - minB; // or along -n by this much
     if (alongN < 0.0 || againstN < 0.0) {
@@ -423,20 +447,86 @@ PatchAxis leastOverlapNormal(const CollisionBody& bodyA, std::uint32_t sa, const
       best = -n;
     }
   };
-  for (const Vec3f& f : bodyB.sphereFaceNormals(sb)) consider(rotAFromB * f.cast<double>());
-  for (const Vec3f& f : bodyA.sphereFaceNormals(sa)) consider(f.cast<double>());
-  std::array<Vec3, CollisionBody::kMaxSphereEdgeDirections> edgesB;
-  const std::span<const Vec3f> edgeDirsB = bodyB.sphereEdgeDirections(sb);
-  for (std::size_t k = 0; k < edgeDirsB.size(); ++k) edgesB[k] = rotAFromB * edgeDirsB[k].cast<double>();
-  for (const Vec3f& ea : bodyA.sphereEdgeDirections(sa)) {
-    for (std::size_t k = 0; k < edgeDirsB.size(); ++k) {
-      const Vec3 axis = ea.cast<double>().cross(edgesB[k]);
-      const double length = axis.norm();
-      if (length < 1e-6) continue;  // parallel edges: their axes are face normals already
-      consider(axis / length);
+  if (sideB.faceted) {
+    for (const Vec3f& f : sideB.body.sphereFaceNormals(sideB.sphere)) consider(rotAFromB * f.cast<double>());
+  }
+  if (sideA.faceted) {
+    for (const Vec3f& f : sideA.body.sphereFaceNormals(sideA.sphere)) consider(f.cast<double>());
+  }
+  if (sideA.faceted && sideB.faceted) {
+    std::array<Vec3, CollisionBody::kMaxSphereEdgeDirections> edgesB;
+    const std::span<const Vec3f> edgeDirsB = sideB.body.sphereEdgeDirections(sideB.sphere);
+    for (std::size_t k = 0; k < edgeDirsB.size(); ++k) edgesB[k] = rotAFromB * edgeDirsB[k].cast<double>();
+    for (const Vec3f& ea : sideA.body.sphereEdgeDirections(sideA.sphere)) {
+      for (std::size_t k = 0; k < edgeDirsB.size(); ++k) {
+        const Vec3 axis = ea.cast<double>().cross(edgesB[k]);
+        const double length = axis.norm();
+        if (length < 1e-6) continue;  // parallel edges: their axes are face normals already
+        consider(axis / length);
+      }
     }
+  } else {
+    consider(nB);
+    consider(nA);
   }
   return apart ? PatchAxis::kApart : PatchAxis::kChosen;
+}
+
+// Depth and point of a contact along a chosen normal n (A frame, B -> A) between two sides of
+// which at least one is faceted: the sides overlap along n over [min_A(n), max_B(n)]; depth =
+// max_B(n) - min_A(n), capped by the spheres' D&O depth (both bound the same thing from above;
+// a sphere side overestimates its surface); the point is the D&O point moved along n onto the
+// middle of that overlap (from a curved side's centre instead, see below) and, across n, clamped
+// into the common extent of the two sides along
+// two tangents (so it lies where both patches are, not beside the smaller one). For a box
+// resting on a box or a floor this is the true penetration and a point in the contact face at
+// every level, where the D&O point lies up to a sphere radius inside the upper box and its depth
+// is the spheres' overlap. Returns false when the sides are apart along n.
+bool patchDepthAndPoint(const PatchSide& sideA, const PatchSide& sideB, const Vec3& n, Contact& c) {
+  const double maxB = sideB.support(n);
+  const double minA = -sideA.support(-n);
+  const double overlap = maxB - minA;
+  if (overlap < 0.0) return false;
+  c.depth = std::min(c.depth, overlap);
+  // A curved side is its sphere here, whose support along the normal lies straight through its
+  // centre: start there (the D&O point of a small sphere inside a floor's huge root sphere lies
+  // on the nearly horizontal centre line, off to the side).
+  const Vec3 start = !sideA.faceted ? sideA.centre : !sideB.faceted ? sideB.centre : c.point;
+  Vec3 p = start + (0.5 * (maxB + minA) - n.dot(start)) * n;
+  const Vec3 t1 = n.unitOrthogonal();
+  const Vec3 t2 = n.cross(t1);
+  for (const Vec3& t : {t1, t2}) {
+    const double lo = std::max(-sideA.support(-t), -sideB.support(-t));
+    const double hi = std::min(sideA.support(t), sideB.support(t));
+    if (lo > hi) continue;  // no common extent along t (the sides overlap only along n)
+    const double s = t.dot(p);
+    p += (std::clamp(s, lo, hi) - s) * t;
+  }
+  c.point = p;
+  return true;
+}
+
+// A rule-1 normal within 2 degrees of a face normal of a side becomes that face normal:
+// the maps' normals carry the codec's error (up to ~0.95 deg for oct16), and the patch depth
+// along a normal tilted by e grows by e times the patch's width (a box on a 4 m slab: 0.16 deg
+// doubled the depth of a 0.01 m contact).
+void snapToFaceNormal(const PatchSide& sideA, const PatchSide& sideB, const Eigen::Matrix3d& rotAFromB, Vec3& n) {
+  // sphereFaceNormals: also for patches with too many vertices to be faceted (a finely
+  // tessellated flat floor), empty for curved ones.
+  for (const Vec3f& f : sideB.body.sphereFaceNormals(sideB.sphere)) {
+    const Vec3 fA = rotAFromB * f.cast<double>();  // B's outward normal points toward A
+    if (fA.dot(n) > kFaceMatchCos) {
+      n = fA;
+      return;
+    }
+  }
+  for (const Vec3f& f : sideA.body.sphereFaceNormals(sideA.sphere)) {
+    const Vec3 fA = -f.cast<double>();  // A's outward normal points toward B
+    if (fA.dot(n) > kFaceMatchCos) {
+      n = fA;
+      return;
+    }
+  }
 }
 
 Vec3 differenceNormal(const Vec3& nA, const Vec3& nB, const Vec3& dosNormal) {
@@ -446,15 +536,14 @@ Vec3 differenceNormal(const Vec3& nA, const Vec3& nB, const Vec3& dosNormal) {
   return sum / len;
 }
 
+// Contacts of the sphere models, one per frontier pair. Pairs proven apart (cfm: a separating
+// axis between their patches) give none.
 void sphereContacts(ContactModel model, const CollisionBody& bodyA, const CollisionBody& bodyB, const Pose& xfAFromB,
-                    const std::vector<SpherePair>& front, std::vector<Contact>& out, std::vector<Contact>& apart) {
+                    const std::vector<SpherePair>& front, std::vector<Contact>& out) {
   const SphereTree& ta = bodyA.sphereTree();
   const SphereTree& tb = bodyB.sphereTree();
-  const std::size_t first = out.size();
-  apart.clear();
   const Eigen::Matrix3d rotAFromB = xfAFromB.rotation.toRotationMatrix();
   for (const SpherePair& p : front) {
-    bool proven = false;  // the pair's patches are proven apart
     const Vec3 cA = ta.center(p.a);
     const Vec3 cB = xfAFromB.apply(tb.center(p.b));
     const double rA = ta.radius[p.a];
@@ -467,48 +556,55 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
     c.level = std::max(bodyA.sphereLevel(p.a), bodyB.sphereLevel(p.b));
     if (model == ContactModel::kDos) {
       c.normal = dos.normal;
-    } else {
-      const ContactNormalModel m =
-          model == ContactModel::kCfm ? ContactNormalModel::kClosestFeatureMap : ContactNormalModel::kAverage;
-      const ClosestFeatureMap& mapA = bodyA.closestFeatureMap();
-      const ClosestFeatureMap& mapB = bodyB.closestFeatureMap();
-      // Each sphere is looked up at its surface point facing the other sphere: the sample
-      // nearest the D&O point whenever that point lies between the centres, and still the
-      // side facing the contact when a large sphere's radical plane lies beyond the small
-      // sphere's centre (then the D&O point would look up the small sphere's far side).
-      const Vec3 nA = contactNormal(m, ta, mapA, p.a, cA - rA * dos.normal);
-      const Vec3 pointB = xfAFromB.applyInverse(cB + rB * dos.normal);
-      const Vec3 nBlocal = contactNormal(m, tb, mapB, p.b, pointB);
-      const Vec3 nB = xfAFromB.rotation * nBlocal;
-      // The face test only matters where the normals disagree (rule 2), and only for cfm: the
-      // average model is the paper's straw man and stays plain.
-      c.normal = differenceNormal(nA, nB, dos.normal);
-      const PatchAxis axis = model == ContactModel::kCfm && nB.dot(-nA) < kAgreeCos
-                                 ? leastOverlapNormal(bodyA, p.a, bodyB, p.b, xfAFromB, rotAFromB, c.normal)
-                                 : PatchAxis::kChosen;
-      proven = axis == PatchAxis::kApart;
-      if (axis != PatchAxis::kChosen) {
-        const bool facingA = nA.dot(dos.normal) < 0.0;
-        const bool facingB = nB.dot(dos.normal) > 0.0;
-        if (facingA != facingB) {
-          c.normal = facingB ? nB : Vec3(-nA);
+      out.push_back(c);
+      continue;
+    }
+    const ContactNormalModel m =
+        model == ContactModel::kCfm ? ContactNormalModel::kClosestFeatureMap : ContactNormalModel::kAverage;
+    const ClosestFeatureMap& mapA = bodyA.closestFeatureMap();
+    const ClosestFeatureMap& mapB = bodyB.closestFeatureMap();
+    // Each sphere is looked up at its surface point facing the other sphere: the sample
+    // nearest the D&O point whenever that point lies between the centres, and still the
+    // side facing the contact when a large sphere's radical plane lies beyond the small
+    // sphere's centre (then the D&O point would look up the small sphere's far side).
+    const Vec3 nA = contactNormal(m, ta, mapA, p.a, cA - rA * dos.normal);
+    const Vec3 pointB = xfAFromB.applyInverse(cB + rB * dos.normal);
+    const Vec3 nBlocal = contactNormal(m, tb, mapB, p.b, pointB);
+    const Vec3 nB = xfAFromB.rotation * nBlocal;
+    c.normal = differenceNormal(nA, nB, dos.normal);
+    if (model != ContactModel::kCfm) {
+      // The average model is the paper's straw man and stays plain.
+      out.push_back(c);
+      continue;
+    }
+    const PatchSide sideA{bodyA, p.a, !bodyA.spherePatchVertices(p.a).empty(), cA, rA, nullptr, Vec3::Zero()};
+    const PatchSide sideB{bodyB, p.b, !bodyB.spherePatchVertices(p.b).empty(), cB, rB, &rotAFromB, xfAFromB.translation};
+    // Rule 2 applies wherever a side is faceted, also where the maps agree: a small body's
+    // sphere and a floor's huge root sphere agree on a nearly horizontal normal (the floor's
+    // side face, the body's side facing the floor's centre), and the facets of a polyhedral ball
+    // are tilted against the floor it rests on. Between two curved patches, rule 1 and 3-5.
+    const bool agree = nB.dot(-nA) >= kAgreeCos;
+    const PatchAxis axis = leastOverlapNormal(sideA, sideB, rotAFromB, nA, nB, c.normal);
+    if (axis == PatchAxis::kNotFaceted && agree) snapToFaceNormal(sideA, sideB, rotAFromB, c.normal);
+    if (axis == PatchAxis::kApart) continue;  // the patches cannot touch: no contact
+    if (axis == PatchAxis::kNotFaceted && !agree) {
+      const bool facingA = nA.dot(dos.normal) < 0.0;
+      const bool facingB = nB.dot(dos.normal) > 0.0;
+      if (facingA != facingB) {
+        c.normal = facingB ? nB : Vec3(-nA);
+      } else {
+        const bool faceA = isFaceNormal(nA, bodyA.sphereFaceNormals(p.a));
+        const bool faceB = isFaceNormal(nBlocal, bodyB.sphereFaceNormals(p.b));
+        if (faceA != faceB) {
+          c.normal = faceB ? nB : Vec3(-nA);
         } else {
-          const bool faceA = isFaceNormal(nA, bodyA.sphereFaceNormals(p.a));
-          const bool faceB = isFaceNormal(nBlocal, bodyB.sphereFaceNormals(p.b));
-          if (faceA != faceB) {
-            c.normal = faceB ? nB : Vec3(-nA);
-          } else {
-            c.normal = nB.dot(dos.normal) >= -nA.dot(dos.normal) ? nB : Vec3(-nA);
-          }
+          c.normal = nB.dot(dos.normal) >= -nA.dot(dos.normal) ? nB : Vec3(-nA);
         }
       }
     }
-    (proven ? apart : out).push_back(c);
+    if ((sideA.faceted || sideB.faceted) && !patchDepthAndPoint(sideA, sideB, c.normal, c)) continue;
+    out.push_back(c);
   }
-  // A pair whose faceted patches have a separating axis cannot touch: its sphere overlap is the
-  // spheres' looseness, and its lookup normals are side faces. Such pairs give contacts only
-  // when no other pair does (the query still reports the collision of its frontier).
-  if (out.size() == first) out.insert(out.end(), apart.begin(), apart.end());
 }
 
 Contact toWorld(const Contact& local, const Pose& xfWorldFromA) {
@@ -811,13 +907,14 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
         for (std::size_t i = 0; i < s.sphereFront.size(); ++i) {
           if (!s.pairDone[i]) s.sphereNext.push_back(s.sphereFront[i]);
         }
-        sphereContacts(ContactModel::kDos, a, b, xfAFromB, s.sphereNext, s.raw, s.apart);
+        sphereContacts(ContactModel::kDos, a, b, xfAFromB, s.sphereNext, s.raw);
         finished = false;
       }
       result.colliding = complete ? !s.raw.empty() : !s.sphereFront.empty();
     } else {
-      sphereContacts(model, a, b, xfAFromB, s.sphereFront, s.raw, s.apart);
-      result.colliding = !s.sphereFront.empty();
+      sphereContacts(model, a, b, xfAFromB, s.sphereFront, s.raw);
+      // cfm drops pairs proven apart: colliding means some pair gave a contact.
+      result.colliding = model == ContactModel::kCfm ? !s.raw.empty() : !s.sphereFront.empty();
     }
     if (c != nullptr) {
       c->a = &a;
