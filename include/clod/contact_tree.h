@@ -101,7 +101,7 @@ struct ContactFieldSample {
   bool insideRoot = true;
 };
 
-/// A built contact tree. Plain data: the builder fills it, the bake file stores it as is, and
+/// A built contact tree. Plain data: the builder fills it, the bake file stores its arrays, and
 /// any number of threads may query it concurrently (every query is const and allocation-free).
 struct ContactTree {
   // --- Geometry of the root cube and the build parameters (body frame, mesh units) ---------
