@@ -35,6 +35,13 @@ public:
     }
     out_ += ']';
   }
+  // ,\n"k":[values] -- a member after the first of an object.
+  template <class T>
+  void nextArray(std::string_view k, const std::vector<T>& values) {
+    raw(",\n");
+    key(k);
+    array(values);
+  }
   std::string take() { return std::move(out_); }
 
 private:
@@ -164,35 +171,19 @@ std::string encodeDebugLayers(const DebugLayers& layers) {
     j.raw("{");
     j.key("time");
     j.array(f.time);
-    j.raw(",\n");
-    j.key("step");
-    j.array(f.step);
-    j.raw(",\n");
-    j.key("kinetic_energy");
-    j.array(f.kineticEnergy);
-    j.raw(",\n");
-    j.key("potential_energy");
-    j.array(f.potentialEnergy);
-    j.raw(",\n");
-    j.key("total_energy");
-    j.array(total);
-    j.raw(",\n");
-    j.key("contacts");
-    j.array(f.contacts);
-    j.raw(",\n");
-    j.key("tests_spent");
-    j.array(f.testsSpent);
-    j.raw(",\n");
-    j.key("tests_budget");
-    j.array(f.testsBudget);
+    j.nextArray("step", f.step);
+    j.nextArray("kinetic_energy", f.kineticEnergy);
+    j.nextArray("potential_energy", f.potentialEnergy);
+    j.nextArray("total_energy", total);
+    j.nextArray("contacts", f.contacts);
+    j.nextArray("tests_spent", f.testsSpent);
+    j.nextArray("tests_budget", f.testsBudget);
     j.raw("},\n");
     j.key("contacts");
     j.raw("{");
     j.key("frame_offsets");
     j.array(f.contactOffsets);
-    j.raw(",\n");
-    j.key("data");
-    j.array(f.contactData);
+    j.nextArray("data", f.contactData);
     j.raw("}");
   }
   j.raw(",\n");
@@ -234,9 +225,7 @@ std::string encodeDebugLayers(const DebugLayers& layers) {
         j.raw(",");
         j.key("points");
         j.array(level.points);
-        j.raw(",\n");
-        j.key("normals");
-        j.array(level.normals);
+        j.nextArray("normals", level.normals);
         j.raw("}");
       }
       j.raw("]");
@@ -249,9 +238,7 @@ std::string encodeDebugLayers(const DebugLayers& layers) {
       j.raw("{");
       j.key("cells");
       j.array(body.contactTree->cells);
-      j.raw(",\n");
-      j.key("halfspaces");
-      j.array(body.contactTree->halfSpaces);
+      j.nextArray("halfspaces", body.contactTree->halfSpaces);
       j.raw("}");
     }
     j.raw("}");

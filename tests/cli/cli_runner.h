@@ -23,7 +23,14 @@ struct CliRun {
 inline CliRun runCli(const std::string& args) {
   namespace fs = std::filesystem;
   const fs::path errPath = fs::temp_directory_path() / ("clod_cli_test_" + std::to_string(::getpid()) + ".err");
-  const std::string command = std::string("\"") + CLOD_CLI_PATH + "\" " + args + " 2>\"" + errPath.string() + "\"";
+  // Appended piece by piece: GCC 12 reports a false -Wrestrict on `std::string("\"") + ...` chains.
+  std::string command = "\"";
+  command += CLOD_CLI_PATH;
+  command += "\" ";
+  command += args;
+  command += " 2>\"";
+  command += errPath.string();
+  command += '"';
   CliRun run;
   FILE* pipe = ::popen(command.c_str(), "r");
   if (!pipe) return run;
