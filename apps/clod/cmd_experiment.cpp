@@ -92,6 +92,8 @@ const CommandRegistration kRegistration("experiment", [](CLI::App& app) {
   sub->add_option("--trials", options->trials, "randomised runs per configuration (0 = each experiment's default)")
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--seed", options->seed, "seed of every random choice")->capture_default_str();
+  sub->add_flag("--quick", options->quick,
+                "reduced configuration for smoke tests (shorter simulations; same keys, not the report's numbers)");
   return [options] { return options->name == kAll ? runAll(*options) : runOne(*options); };
 });
 

@@ -34,6 +34,9 @@ struct ExperimentOptions {
   /// conditions (0 = the experiment's own default, which is what the report uses).
   long trials = 0;
   std::uint64_t seed = 1;  ///< seed of every random choice (same seed, same numbers)
+  /// `--quick`: a reduced configuration for smoke tests (shorter simulated times, fewer levels);
+  /// same JSON keys, but not the numbers the report shows. Experiments without one ignore it.
+  bool quick = false;
 };
 
 /// One curve of a plot: columns of a CSV file the experiment writes (header line skipped).

@@ -17,6 +17,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <iomanip>
 #include <map>
 #include <memory>
@@ -296,6 +297,9 @@ ExperimentResult runFidelity(const ExperimentOptions& options) {
   std::map<std::string, std::map<std::uint32_t, std::map<std::string, std::array<double, 2>>>> wide;
   std::vector<std::vector<std::string>> reportRows;
   // Bake (and load) both shapes first: a missing mesh fails before any simulation runs.
+  // A missing bunny file fails at once, not after the cube's bake (seconds).
+  const std::filesystem::path bunnyPath = sharedMeshPath(options, "bunny-1500.obj");
+  if (!std::filesystem::exists(bunnyPath)) (void)loadMesh(bunnyPath);
   std::vector<Shape> shapes;
   for (const char* shapeName : {"cube", "bunny-1500"}) shapes.push_back(makeShape(shapeName, options));
   for (Shape& shape : shapes) {
@@ -374,7 +378,7 @@ ExperimentResult runFidelity(const ExperimentOptions& options) {
            << num(st[kAngular].mean, 3) << "  " << num(st[kGap].mean, 3) << "\n";
       wide[shape.name][level][modelName] = {st[kOverall].mean, st[kAngMoving].mean};
       reportRows.push_back({shape.name, modelName, std::to_string(level),
-                            num(st[kOverall].mean, 3) + " &plusmn; " + num(st[kOverall].ci95, 3),
+                            num(st[kOverall].mean, 3) + " ± " + num(st[kOverall].ci95, 3),
                             num(st[kAngMoving].mean, 3), num(st[kAngResting].mean, 3), num(st[kLinear].mean, 3),
                             num(st[kAngular].mean, 3), num(st[kGap].mean, 3)});
     }
@@ -439,7 +443,7 @@ ExperimentResult runFidelity(const ExperimentOptions& options) {
          << " levels</li>";
   }
   html << "</ul>";
-  html << htmlTable({"shape", "model", "level", "overall (&plusmn; 95% CI)", "angular (moving)", "angular (resting)",
+  html << htmlTable({"shape", "model", "level", "overall (± 95% CI)", "angular (moving)", "angular (resting)",
                      "linear velocity", "angular velocity", "gap"},
                     reportRows);
   html << "<p><b>Comparison.</b> The paper's claims to check in the table: cfm at or above dos at every level, "

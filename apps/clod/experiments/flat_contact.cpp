@@ -224,13 +224,13 @@ struct RestSeries {
   std::vector<double> driftMm, rotationDeg, contacts, iterations;
 };
 
-nlohmann::json runRest(const Run& run, const Shape& ground, const Shape& box, RestSeries& series) {
+nlohmann::json runRest(const Run& run, const Shape& ground, const Shape& box, double restSeconds, RestSeries& series) {
   World world(worldSettings(run));
   world.addBody(staticBody("ground", ground, kFrictionRest));
   const Vec3 p0(0.0, 0.0, 0.25 + kBoxHalf);  // bottom face exactly on the slab's top face
   const BodyId id = world.addBody(dynamicBox(box, p0, Vec3::Zero(), kFrictionRest));
   const Quat q0 = world.state(id).orientation;
-  const int steps = static_cast<int>(std::lround(kRestSeconds / kDt));
+  const int steps = static_cast<int>(std::lround(restSeconds / kDt));
   std::vector<double> iterationsPerSubstep, contacts;
   std::uint64_t substeps = 0, capped = 0;
   double maxRotation = 0.0;
@@ -289,13 +289,13 @@ struct SlideTrack {
 };
 
 SlideTrack runSlide(const Run& run, const Shape& ground, const Vec3& groundPosition, const Shape& box, double startY,
-                    double speed) {
+                    double speed, double slideSeconds) {
   World world(worldSettings(run));
   RigidBodyDesc g = staticBody("ground", ground, kFrictionSlide);
   g.position = groundPosition;  // the top face at z = 0
   world.addBody(g);
   const BodyId id = world.addBody(dynamicBox(box, Vec3(-1.2, startY, kBoxHalf), Vec3(speed, 0.0, 0.0), kFrictionSlide));
-  const int steps = static_cast<int>(std::lround(kSlideSeconds / kDt));
+  const int steps = static_cast<int>(std::lround(slideSeconds / kDt));
   SlideTrack track;
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 0; k < steps; ++k) {
@@ -313,6 +313,10 @@ ExperimentResult runFlatContact(const ExperimentOptions& options) {
     throw Error(ErrorCode::kInvalidArgument, "--trials " + std::to_string(options.trials) + " outside [0, 100] (flat-contact: bump runs)");
   }
   const long trials = options.trials > 0 ? options.trials : kDefaultTrials;
+  // --quick (smoke tests): 1 s of resting contact instead of 10 and 1 s of sliding instead of 2
+  // (the box reaches the bump after ~0.5 s); the contact tree's 10 s at rest dominate the run.
+  const double restSeconds = options.quick ? 1.0 : kRestSeconds;
+  const double slideSeconds = options.quick ? 1.0 : kSlideSeconds;
   const Shape box = makeShape(makeBox(Vec3::Constant(kBoxHalf)), "box", 6);
   const Shape slab = makeShape(makeBox(Vec3(2.0, 2.0, 0.25)), "slab", 6);
   const Shape bumpGround = makeShape(makeBumpSlab(2.5, 1.5, 0.5, kBumpX, kBumpY, kBumpHeight, kBumpRadius), "bump-slab", 8);
@@ -324,7 +328,7 @@ ExperimentResult runFlatContact(const ExperimentOptions& options) {
   nlohmann::json& doc = result.document;
   doc["experiment"] = "flat-contact";
   doc["paper"] = "Kaufman, Sueda & Pai 2007 (contact trees): stable flat contact, small-scale features";
-  doc["settings"] = {{"dt", kDt}, {"rest_seconds", kRestSeconds}, {"slide_seconds", kSlideSeconds},
+  doc["settings"] = {{"dt", kDt}, {"rest_seconds", restSeconds}, {"slide_seconds", slideSeconds},
                      {"velocity_iterations", kVelocityIterations}, {"convergence_rel", kConvergenceRel},
                      {"box_half", kBoxHalf}, {"bump_height", kBumpHeight}, {"bump_radius", kBumpRadius},
                      {"bump_center", {kBumpX, kBumpY}}, {"slide_speed", kSlideSpeed},
@@ -341,11 +345,11 @@ ExperimentResult runFlatContact(const ExperimentOptions& options) {
   std::vector<RestSeries> restSeries(restRuns.size());
   csv << "part,model,budget,raw_contacts,manifold_contacts,mean_contacts,median_iterations,p95_iterations,drift_mm,"
          "horizontal_drift_mm,vertical_drift_mm,rotation_deg,max_rotation_deg,ms_per_step\n";
-  text << "Resting box on a slab, " << kRestSeconds << " s (unlimited budget; up to " << kVelocityIterations
+  text << "Resting box on a slab, " << restSeconds << " s (unlimited budget; up to " << kVelocityIterations
        << " velocity iterations, convergence 1e-6)\n"
        << "  model          raw  manifold  mean-contacts  median-iters  drift-mm  rotation-deg  ms/step\n";
   for (std::size_t i = 0; i < restRuns.size(); ++i) {
-    const nlohmann::json row = runRest(restRuns[i], slab, box, restSeries[i]);
+    const nlohmann::json row = runRest(restRuns[i], slab, box, restSeconds, restSeries[i]);
     doc["rest"].push_back(row);
     csv << "rest," << row["model"].get<std::string>() << "," << restRuns[i].budget << "," << row["raw_contacts"] << ","
         << row["manifold_contacts"] << "," << row["mean_contacts"].get<double>() << "," << row["median_iterations"].get<double>()
@@ -408,8 +412,8 @@ ExperimentResult runFlatContact(const ExperimentOptions& options) {
     const double speed = trial == 0 ? kSlideSpeed : kSlideSpeed * speedJitter(rng);
     std::vector<SlideTrack> bump, flat;
     for (const Run& r : slideRuns) {
-      bump.push_back(runSlide(r, bumpGround, Vec3::Zero(), box, startY, speed));
-      flat.push_back(runSlide(r, flatGround, Vec3::Zero(), box, startY, speed));
+      bump.push_back(runSlide(r, bumpGround, Vec3::Zero(), box, startY, speed, slideSeconds));
+      flat.push_back(runSlide(r, flatGround, Vec3::Zero(), box, startY, speed, slideSeconds));
     }
     // Bump effect of run i at step k: lift (bump z - flat z), heading and sideways differences.
     auto effect = [&](std::size_t i, std::size_t k) {
@@ -454,7 +458,7 @@ ExperimentResult runFlatContact(const ExperimentOptions& options) {
   csv << "part,model,budget,trials,max_lift_mm,flat_max_lift_mm,final_x,flat_final_x,final_yaw_deg,final_offset_mm,"
          "bump_lift_mm,bump_yaw_deg,bump_offset_mm,bump_lift_error_mm,bump_yaw_error_deg,rms_position_error_mm,"
          "max_yaw_error_deg,ms_per_step\n";
-  text << "Box sliding over a " << kBumpHeight * 100 << " cm bump at " << kSlideSpeed << " m/s, " << kSlideSeconds
+  text << "Box sliding over a " << kBumpHeight * 100 << " cm bump at " << kSlideSpeed << " m/s, " << slideSeconds
        << " s; means over " << trials << " start(s); bump effect = track on the bump - track on flat ground\n"
        << "  model         lift-mm  flat-lift-mm  final-x  effect: lift-mm  yaw-deg  offset-mm | vs reference: rms-mm  yaw-err\n";
   for (std::size_t i = 0; i < slideRuns.size(); ++i) {
@@ -528,9 +532,9 @@ ExperimentResult runFlatContact(const ExperimentOptions& options) {
     const nlohmann::json& r = doc["bump"][i];
     bumpRows.push_back({i == 0 ? "exact (reference)" : slideRuns[i].label(), formatNumber(r["max_lift_mm"].get<double>(), 1),
                         formatNumber(r["flat_max_lift_mm"].get<double>(), 1), formatNumber(r["final_x"].get<double>(), 2),
-                        formatNumber(r["bump_lift_mm"].get<double>(), 1) + " &plusmn; " +
+                        formatNumber(r["bump_lift_mm"].get<double>(), 1) + " ± " +
                             formatNumber(r["spread"]["bump_lift_mm_sd"].get<double>(), 1),
-                        formatNumber(r["bump_yaw_deg"].get<double>(), 2) + " &plusmn; " +
+                        formatNumber(r["bump_yaw_deg"].get<double>(), 2) + " ± " +
                             formatNumber(r["spread"]["bump_yaw_deg_sd"].get<double>(), 2),
                         formatNumber(r["bump_offset_mm"].get<double>(), 1), formatNumber(r["rms_position_error_mm"].get<double>(), 0),
                         formatNumber(r["ms_per_step"].get<double>(), 2)});

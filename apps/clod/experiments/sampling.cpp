@@ -7,6 +7,7 @@
 //             neighbour_definition} for the other neighbour definitions
 //   paper_formula[] {scheme, stacks, samples, queries, misses, miss_rate, max_excess_deg,
 //             mean_excess_deg}: how often the paper's plain lookup formula misses the nearest sample
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <optional>
@@ -147,6 +148,65 @@ ExperimentResult runSampling(const ExperimentOptions& options) {
   plot.series.push_back({"sampling_std_dev.csv", "1:7", "paper: polar", "points pointtype 6 pointsize 2", ""});
   plot.series.push_back({"sampling_std_dev.csv", "1:8", "paper: adaptive-polar", "points pointtype 8 pointsize 2", ""});
   result.plots.push_back(std::move(plot));
+
+  // Report: Table 2 and Table 1 beside the paper's values, with the differences explained.
+  std::vector<std::vector<std::string>> t2;
+  double minRatio = 1e30, maxRatio = 0.0;
+  std::map<int, std::map<std::string, double>> ours;  // stacks -> scheme -> std dev
+  for (const nlohmann::json& row : doc["rows"]) {
+    ours[row["stacks"].get<int>()][row["scheme"].get<std::string>()] = row["std_dev"].get<double>();
+    if (row["paper_std_dev"].is_null()) continue;
+    const double ratio = row["std_dev"].get<double>() / row["paper_std_dev"].get<double>();
+    minRatio = std::min(minRatio, ratio);
+    maxRatio = std::max(maxRatio, ratio);
+    t2.push_back({row["scheme"].get<std::string>(), std::to_string(row["stacks"].get<int>()),
+                  std::to_string(row["samples"].get<std::uint32_t>()), formatNumber(row["std_dev"].get<double>(), 4),
+                  formatNumber(row["paper_std_dev"].get<double>(), 4), formatNumber(ratio, 2)});
+  }
+  bool adaptiveBelowFull = true;
+  for (const auto& [stacks, bySchemes] : ours) {
+    if (bySchemes.count("polar") && bySchemes.count("adaptive-polar")) {
+      adaptiveBelowFull = adaptiveBelowFull && bySchemes.at("adaptive-polar") < bySchemes.at("polar");
+    }
+  }
+  std::vector<std::vector<std::string>> t1;
+  for (const nlohmann::json& row : doc["table1"]) {
+    if (row["paper_root_samples"].is_null()) continue;
+    t1.push_back({row["scheme"].get<std::string>(),
+                  std::to_string(row["root_stacks"].get<int>()) + " → " + std::to_string(row["leaf_stacks"].get<int>()),
+                  std::to_string(row["root_samples"].get<std::uint32_t>()) + " (" +
+                      std::to_string(row["paper_root_samples"].get<std::uint32_t>()) + ")",
+                  std::to_string(row["leaf_samples"].get<std::uint32_t>()) + " (" +
+                      std::to_string(row["paper_leaf_samples"].get<std::uint32_t>()) + ")"});
+  }
+  std::vector<std::vector<std::string>> misses;
+  for (const nlohmann::json& row : doc["paper_formula"]) {
+    if (row["stacks"] != 10 && row["stacks"] != 16) continue;
+    misses.push_back({row["scheme"].get<std::string>(), std::to_string(row["stacks"].get<int>()),
+                      formatNumber(100.0 * row["miss_rate"].get<double>(), 1) + " %",
+                      formatNumber(row["max_excess_deg"].get<double>(), 1)});
+  }
+  std::ostringstream html;
+  html << "<h3>Table 2: standard deviation of neighbour distances (unit sphere, " << neighbourDefinitionName(primary)
+       << ")</h3>" << htmlTable({"scheme", "stacks", "samples", "ours", "paper", "ours / paper"}, t2)
+       << "<p><b>Comparison.</b> Ours are " << formatNumber(minRatio, 2) << "&ndash;" << formatNumber(maxRatio, 2)
+       << " times the paper's. The paper does not define &ldquo;neighbouring&rdquo;; we count each sample's 4 nearest "
+          "samples (chord length), the definition closest to its figures (nearest-1 and nearest-6 are in the JSON; "
+          "docs/sampling.md). Whether pole duplicates, ties and mutual pairs count is not stated either, which is what "
+          "the remaining 10&ndash;20 % reflect. The paper's conclusions hold: adaptive polar spreads less than full "
+          "polar at every stack count ("
+       << (adaptiveBelowFull ? "yes" : "NO") << " here) and both fall as the stacks grow.</p>"
+       << "<h3>Table 1: samples per sphere, root and level-2 leaves (stacks halved per level)</h3>"
+       << htmlTable({"scheme", "stacks root → leaf", "root (paper)", "leaf (paper)"}, t1)
+       << "<p><b>Comparison.</b> 65 / 3 at 10 stacks and 11 at the leaves at 16 match; the paper's 167 at the root at "
+          "16 stacks is not what the adaptive rule gives (163), and no variant of the rule we tried gives all four "
+          "counts (docs/sampling.md). The bake sizes are in the <a href=\"#sizes\">sizes</a> section.</p>"
+       << "<h3>The paper's O(1) lookup formula vs the exact nearest sample</h3>"
+       << htmlTable({"scheme", "stacks", "misses the nearest sample", "worst extra angle (deg)"}, misses)
+       << "<p>The paper's index formula (its equations 4&ndash;5) picks the ring and the slot by rounding &phi; and "
+          "&theta;; near ring boundaries that is not the nearest sample. It reports no such figure; our default lookup "
+          "checks the neighbouring rings and is exact.</p>";
+  result.reportHtml = html.str();
   result.csv = csv.str();
   result.text = text.str();
   return result;
