@@ -29,8 +29,11 @@ enum class ContactModel : std::uint8_t {
   /// average normals of the triangles each sphere bounds (ClosestFeatureMap::averageNormal),
   /// combined as normalize(n_B - n_A) (falls back to D&O where that is undefined).
   kAverage = 1,
-  /// Closest feature maps: D&O point and depth, each sphere's CFM normal for the direction of
-  /// the contact point from its centre, combined by the flatness rule of docs/narrow-phase.md.
+  /// Closest feature maps: each sphere's CFM normal for the direction of the contact point from
+  /// its centre, combined by the rules of docs/narrow-phase.md (a separating-axis choice where a
+  /// sphere is a faceted patch); D&O point and depth, or, where a sphere is a faceted patch, the
+  /// patches' overlap along the normal as depth and a point in it. Pairs whose patches a
+  /// separating axis proves apart give no contact.
   kCfm = 2,
   /// Contact trees (Kaufman et al. 2007): traversal of the two contact trees, then contact
   /// sampling of the frontier cell pairs (contact_sampling.h), both ways round.

@@ -27,7 +27,8 @@
 // Interruption keeps a consistent covering frontier: a pair is either expanded completely or kept
 // whole; when the budget runs out in the middle of an expansion, that expansion's partial
 // results are discarded (its tests stay counted) and the pair stays as it was. The answer is
-// then built from the frontier: one D&O contact per pair for the sphere models, contact sampling
+// then built from the frontier: one contact per pair for the sphere models (D&O; cfm:
+// none for pairs proven apart, patch depth and point where a sphere is a faceted patch), contact sampling
 // of every frontier cell pair for the contact tree.
 //
 // Exact model: after the sphere-tree traversal has reached leaf x leaf pairs, the triangle
