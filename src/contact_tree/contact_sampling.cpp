@@ -103,7 +103,10 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
   // cell, all on one side of the small body (a box dropped on a slab at 16 tests got its first
   // contacts under one quarter of its face and tipped over). No two samples closer than 4 eps_s:
   // the field cannot tell such points apart.
-  const double hMin = std::min(h, hO);
+  // Only for an interrupted query's coarse (inner) cell: at leaves the finer lattice puts samples
+  // right beside the other body's edges, whose field there points out of its side faces (the
+  // box-on-box tests' normals turned 90 degrees), and leaves are small enough on their own.
+  const double hMin = treeS.isLeaf(cellS.node) ? h : std::min(h, hO);
   const double perAxis = std::clamp(std::floor(hMin / (4.0 * treeS.errorAbs)), 1.0, double(settings.samplesPerCellAxis));
   const double spacing = hMin / perAxis;
   // The plane meets the smaller cell within a disc of radius half its diagonal around the
@@ -111,12 +114,12 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
   // partner cell of cellS).
   const double radiusMin = 0.8660254037844386 * hMin;
   int i0 = 0, j0 = 0;
-  if (hO < h) {
+  if (hMin < h) {
     const Vec3 centreO = xfWorldFromS.applyInverse(xfWorldFromO.apply(treeO.cellCenter(cellO)));
     i0 = static_cast<int>(std::lround(u.dot(centreO - onPlane) / spacing));
     j0 = static_cast<int>(std::lround(v.dot(centreO - onPlane) / spacing));
   }
-  const int reach = static_cast<int>(std::ceil(radiusMin / spacing)) + 1;
+  const int reach = static_cast<int>(std::ceil(radiusMin / spacing));
   const Vec3 normalWorldS = xfWorldFromS.rotation * n;
   const double conflictCos = std::cos(settings.normalConflictDeg * kPi / 180.0);
   const bool flatS = double(hs->fitError) <= kFlatFitRel * h;

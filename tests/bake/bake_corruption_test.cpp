@@ -47,7 +47,7 @@ std::vector<std::size_t> damagePositions(const std::vector<std::byte>& file, std
 TEST(BakeCorruption, EveryFlippedByteIsRejected) {
   const BakeContents original = makeTestContents();
   const std::vector<std::byte> file = encodeBake(original);
-  const std::size_t samples = test::sanitizerScale() ? 300 : file.size();
+  const std::size_t samples = test::sanitizerRun() ? 300 : file.size();
   const auto positions = damagePositions(file, samples);
   ASSERT_GE(positions.size(), std::min<std::size_t>(300, file.size()));
   std::size_t rejected = 0;
@@ -65,7 +65,7 @@ TEST(BakeCorruption, EveryFlippedByteIsRejected) {
 TEST(BakeCorruption, EveryTruncationIsTruncatedOrCorrupt) {
   const BakeContents original = makeTestContents();
   const std::vector<std::byte> file = encodeBake(original);
-  const std::size_t step = test::sanitizerScale() ? 7 : 1;
+  const std::size_t step = test::sanitizerRun() ? 7 : 1;
   for (std::size_t length = 0; length < file.size(); length += step) {
     const std::vector<std::byte> cut(file.begin(), file.begin() + static_cast<std::ptrdiff_t>(length));
     const ErrorCode code = thrownCode([&] { decodeBake(cut); });

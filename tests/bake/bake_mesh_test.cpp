@@ -101,7 +101,7 @@ TEST(BakeCorruption, FlippedBytesAndTruncationsOfARealBakeAreRejected) {
   const std::size_t tableEnd = 48 + 32 * BakeFileReader(file).entries().size();
   std::vector<std::size_t> positions;
   for (std::size_t i = 0; i < tableEnd; ++i) positions.push_back(i);
-  const std::size_t samples = test::sanitizerScale() ? 200 : 600;
+  const std::size_t samples = test::sanitizerRun() ? 200 : 600;
   for (std::size_t k = 0; k < samples; ++k) positions.push_back(tableEnd + k * (file.size() - tableEnd) / samples);
   positions.push_back(file.size() - 1);
   for (std::size_t at : positions) {
@@ -113,7 +113,7 @@ TEST(BakeCorruption, FlippedBytesAndTruncationsOfARealBakeAreRejected) {
     } catch (const Error&) {
     }
   }
-  const std::size_t step = std::max<std::size_t>(1, file.size() / (test::sanitizerScale() ? 300 : 3000));
+  const std::size_t step = std::max<std::size_t>(1, file.size() / (test::sanitizerRun() ? 300 : 3000));
   for (std::size_t length = 0; length < file.size(); length += step) {
     const std::vector<std::byte> cut(file.begin(), file.begin() + static_cast<std::ptrdiff_t>(length));
     const ErrorCode code = thrownCode([&] { decodeBake(cut); });

@@ -13,14 +13,9 @@
 
 #include "clod/bake.h"
 #include "clod/primitives.h"
+#include "support/test_scale.h"
 
 namespace clod::test {
-
-/// True in the ASan+UBSan CI run, where sample counts are reduced.
-inline bool sanitizerScale() {
-  const char* scale = std::getenv("CLOD_TEST_SCALE");
-  return scale && std::string(scale) == "sanitizer";
-}
 
 /// A three-level tree: the root around everything, one sphere per occupied octant of the
 /// bounding box (by triangle centroid), one sphere per triangle. Spheres enclose their

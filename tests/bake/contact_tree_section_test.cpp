@@ -124,7 +124,7 @@ TEST_F(BakeContactTree, LoadedFieldMatchesTheAnalyticBoxDistance) {
   const Vec3 lo = kBoxCenter - kBoxHalf - Vec3::Constant(tree.bandAbs);
   const Vec3 hi = kBoxCenter + kBoxHalf + Vec3::Constant(tree.bandAbs);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  const int wanted = test::sanitizerScale() ? 500 : 5000;
+  const int wanted = test::sanitizerRun() ? 500 : 5000;
   int tested = 0;
   while (tested < wanted) {
     const Vec3 p(lo.x() + unit(rng) * (hi.x() - lo.x()), lo.y() + unit(rng) * (hi.y() - lo.y()),
@@ -237,7 +237,7 @@ TEST_F(BakeContactTree, TrailingOrMissingPayloadBytesAndNewerVersionsAreRejected
 // former). Many flips (a lattice value's low bit) legitimately give a different valid tree.
 TEST_F(BakeContactTree, ResealedPayloadFlipsAreRejectedOrGiveASafeTree) {
   const std::vector<std::byte> payload = treeBytes(*baked_->contents.contactTree);
-  const std::size_t samples = test::sanitizerScale() ? 150 : 600;
+  const std::size_t samples = test::sanitizerRun() ? 150 : 600;
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   // Fields no valid variation of which exists for this mesh (codec layout, contact_tree_codec.h):

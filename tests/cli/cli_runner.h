@@ -46,6 +46,11 @@ inline CliRun runCli(const std::string& args) {
 }
 
 /// A path in double quotes, for a shell command line.
-inline std::string quoted(const std::filesystem::path& path) { return "\"" + path.string() + "\""; }
+inline std::string quoted(const std::filesystem::path& path) {
+  std::string text = "\"";  // appends, not `"\"" + ...`: GCC 12 -Wrestrict false positive
+  text += path.string();
+  text += '"';
+  return text;
+}
 
 }  // namespace clod::test

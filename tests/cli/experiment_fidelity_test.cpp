@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.h"
+#include "support/test_scale.h"
 
 namespace {
 
@@ -35,10 +36,7 @@ std::string readFile(const fs::path& path) {
 }
 
 // Two trials keep the test short (one under the sanitizers); the contract does not depend on it.
-int trials() {
-  const char* scale = std::getenv("CLOD_TEST_SCALE");
-  return scale != nullptr && std::string(scale) == "sanitizer" ? 1 : 2;
-}
+int trials() { return clod::test::sanitizerRun() ? 1 : 2; }
 const std::string kArgs = "experiment fidelity --trials " + std::to_string(trials()) + " --mesh-dir " + quoted(CLOD_SHARED_MESH_DIR);
 
 TEST(ExperimentFidelityCli, WritesEveryShapeModelLevelRowWithProbabilitiesAndFiles) {

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.h"
+#include "support/test_scale.h"
 
 namespace {
 
@@ -31,8 +32,7 @@ fs::path scratchDir(const std::string& name) {
 }
 
 TEST(ExperimentFlatContactCli, JsonHasRestAndBumpRowsPerModelAndWritesTablesAndPlots) {
-  const char* scale = std::getenv("CLOD_TEST_SCALE");
-  if (scale && std::string(scale) == "sanitizer") {
+  if (clod::test::sanitizerRun()) {
     // Even the --quick second of contact-tree resting contact takes minutes under ASan.
     GTEST_SKIP() << "the contact-tree simulations are too slow under sanitizers; the Release run covers this test";
   }
@@ -108,7 +108,7 @@ TEST(ExperimentFlatContactCli, JsonHasRestAndBumpRowsPerModelAndWritesTablesAndP
 // the experiment's settings (100 iterations) it stays flush. Needs per-patch normals and depths
 // from the narrow phase.
 // Enable with --gtest_also_run_disabled_tests.
-TEST(ExperimentFlatContactCli, DISABLED_ReferenceBoxRisesOverTheBumpButNotOnFlatGround) {
+TEST(ExperimentFlatContactCli, ReferenceBoxRisesOverTheBumpButNotOnFlatGround) {
   const clod::test::CliRun run = runCli("experiment flat-contact --trials 1 --json");
   ASSERT_EQ(run.exitCode, 0) << run.err;
   const auto doc = nlohmann::json::parse(run.out);

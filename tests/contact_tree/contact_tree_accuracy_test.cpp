@@ -66,7 +66,7 @@ TEST_P(ContactTreeOnSharedMesh, LookupGridGivesTheSameAnswersAsDescendingFromThe
   const auto prefix = test::areaPrefix(mesh);
   std::mt19937_64 rng(77);
   std::uniform_real_distribution<double> uni(-0.1, 1.1);
-  const std::uint32_t count = test::sanitizerScale() ? 2'000 : 20'000;
+  const std::uint32_t count = test::sanitizerRun() ? 2'000 : 20'000;
   for (std::uint32_t i = 0; i < count; ++i) {
     const Vec3 p = i % 2 ? test::randomBandPoint(mesh, prefix, built.tree.bandAbs, rng)
                          : built.tree.origin + built.tree.rootSize * Vec3(uni(rng), uni(rng), uni(rng));
@@ -90,7 +90,7 @@ TEST_P(ContactTreeOnSharedMesh, LookupGridGivesTheSameAnswersAsDescendingFromThe
 
 TEST_P(ContactTreeOnSharedMesh, DistanceInBandIsWithinEpsOfExactSignedDistance) {
   const auto& built = sharedTree(GetParam());
-  const std::uint32_t count = test::sanitizerScale() ? 10'000 : 100'000;
+  const std::uint32_t count = test::sanitizerRun() ? 10'000 : 100'000;
   const BandComparison result = compareInBand(built, count, kContactTreeLeafDepth, 1234);
   const double diag = built.tree.meshDiagonal;
   RecordProperty("nodes", std::to_string(built.stats.nodes));
@@ -128,7 +128,7 @@ TEST_P(ContactTreeOnSharedMesh, EarlyStoppedQueriesRespectTheirErrorBoundAlmostE
   const TriangleMesh& mesh = built.exact->mesh();
   const auto prefix = test::areaPrefix(mesh);
   std::mt19937_64 rng(7);
-  const int count = test::sanitizerScale() ? 1000 : 5000;
+  const int count = test::sanitizerRun() ? 1000 : 5000;
   std::vector<Vec3> points(count);
   std::vector<double> exact(count);
   for (auto& p : points) p = test::randomBandPoint(mesh, prefix, built.tree.bandAbs, rng);

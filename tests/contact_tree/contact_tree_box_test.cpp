@@ -190,7 +190,7 @@ TEST(ContactTreeCodec, FlippedBytesEitherFailCleanlyOrGiveASafeTree) {
   encodeContactTree(box.tree, writer);
   std::vector<std::byte> bytes = writer.bytes();
   std::mt19937_64 rng(11);
-  const int trials = test::sanitizerScale() ? 300 : 2000;
+  const int trials = test::sanitizerRun() ? 300 : 2000;
   int rejected = 0;
   for (int trial = 0; trial < trials; ++trial) {
     std::vector<std::byte> corrupt = bytes;

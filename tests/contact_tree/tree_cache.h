@@ -12,18 +12,13 @@
 #include "clod/contact_tree_builder.h"
 #include "clod/mesh_io.h"
 #include "clod/proximity.h"
+#include "support/test_scale.h"
 
 namespace clod::test {
 
-/// True in the ASan+UBSan CI run, where everything is 3-10x slower: fewer samples, coarser eps.
-inline bool sanitizerScale() {
-  const char* scale = std::getenv("CLOD_TEST_SCALE");
-  return scale && std::string(scale) == "sanitizer";
-}
-
 /// eps_s used for the shared-mesh trees: 1e-3 of the diagonal (the headline value);
 /// 4e-3 under sanitizers, where a 1e-3 build of three meshes would take minutes.
-inline double treeErrorRel() { return sanitizerScale() ? 4e-3 : 1e-3; }
+inline double treeErrorRel() { return sanitizerRun() ? 4e-3 : 1e-3; }
 
 struct BuiltTree {
   std::unique_ptr<MeshDistance> exact;

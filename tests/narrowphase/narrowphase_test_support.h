@@ -9,13 +9,9 @@
 #include "clod/collision_body.h"
 #include "clod/contact_tree_builder.h"
 #include "clod/proximity.h"
+#include "support/test_scale.h"
 
 namespace clod::test {
-
-inline bool sanitizerRun() {
-  const char* scale = std::getenv("CLOD_TEST_SCALE");
-  return scale != nullptr && std::string(scale) == "sanitizer";
-}
 
 /// A body with sphere-tree (medial, 8-ary, `depth` levels below the root), closest feature map
 /// (16 root stacks: finer than the paper's 10 so the sphere tests' tolerances stay small) and
