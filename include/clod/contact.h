@@ -38,7 +38,8 @@ enum class ContactModel : std::uint8_t {
   /// Contact trees (Kaufman et al. 2007): traversal of the two contact trees, then contact
   /// sampling of the frontier cell pairs (contact_sampling.h), both ways round.
   kContactTree = 3,
-  /// Polygon-level reference: triangle-triangle intersection of the leaves' triangles.
+  /// Polygon-level reference: triangle-triangle intersection of the leaves' triangles; one
+  /// normal and depth per connected contact patch (query.h).
   kExact = 4,
 };
 

@@ -35,12 +35,19 @@
 // pairs of those leaves (deduplicated: a triangle may belong to several leaves) are tested for
 // intersection, one test each, in (triangle of A, triangle of B) order. Each intersecting pair
 // gives the end points of its intersection segment (or the corners of the overlap polygon of
-// coplanar triangles facing each other) as contacts. All of them share one normal, the gradient
-// of the bodies' intersection volume (B's surface inside A minus A's surface inside B, area-
-// weighted normals, each intersecting triangle clipped by the other body's triangles it meets),
-// and one depth, the distance along that normal between the two inside surfaces' centroids
-// (docs/narrow-phase.md). Pairs of the frontier that did not get that far (interrupted) give
-// D&O contacts.
+// coplanar triangles facing each other) as contacts. The intersecting pairs are grouped into
+// connected patches: two pairs are in one patch when their intersection points coincide (within
+// 1e-7 x the sum of the bodies' diagonals) and both are coplanar (flush face-on-face) or both
+// crossing; so separate touching regions (a box on the ground and against a bump or a wall) are
+// separate patches even where they share a large triangle. Every contact carries its patch's
+// normal, the gradient of the patch's intersection volume (B's surface inside A minus A's
+// surface inside B, area-weighted normals, each intersecting triangle clipped by the other
+// body's triangles it meets in that patch), and its patch's depth, the distance along that normal
+// between the patch's two inside surfaces' centroids (docs/narrow-phase.md; where a face lies
+// wholly inside the other body, e.g. a box's bottom sunk into a slab, it crosses nothing and does
+// not count, and the depth is half the penetration). A flush coplanar patch gets its face normal
+// and depth 0. Patch grouping costs O(k log k) for k contact points. Pairs of the frontier that
+// did not get that far (interrupted) give D&O contacts.
 //
 // Contacts are finally reduced to a manifold (reduceManifold, contact.h).
 

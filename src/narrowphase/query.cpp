@@ -125,12 +125,33 @@ struct QueryScratch::Impl {
   std::vector<TrianglePairRef> trianglePairs;
   struct KeyedContact {
     std::uint64_t key;
+    std::uint32_t pair;  // index into volumePairs (insertion order)
     Contact contact;
   };
   std::vector<KeyedContact> exactContacts;
   std::vector<std::uint8_t> pairDone;
   std::vector<std::uint64_t> pairSet;  // open-addressing set of triangle-pair keys
-  std::vector<std::array<std::uint32_t, 2>> volumePairs;
+  // Intersecting triangle pairs of the exact model: triangles, patch (after grouping).
+  struct VolumePair {
+    std::uint32_t ta, tb, patch;
+  };
+  std::vector<VolumePair> volumePairs;
+  std::vector<std::uint8_t> pairCoplanar;  // per volume pair (insertion order)
+  std::vector<Vec3> pairNormalB;           // B's face normal per volume pair, A's frame
+  std::vector<std::uint32_t> patchParent;  // union-find over volume pairs
+  struct CellPoint {
+    std::array<std::int64_t, 3> cell;
+    std::uint32_t contact;
+  };
+  std::vector<CellPoint> cellPoints;
+  std::vector<Vec3> patchNormal;
+  std::vector<double> patchDepth;
+  struct PatchSums {
+    Vec3 centroidA, centroidB, fallbackNormal;
+    double areaA, areaB;
+    bool seen;
+  };
+  std::vector<PatchSums> patchSums;
   std::vector<std::uint32_t> clippers;
   std::vector<Vec3> poly, polyTmp;
   std::vector<Contact> raw;
@@ -666,42 +687,150 @@ Vec3 polygonAreaVector(const std::vector<Vec3>& poly) {
   return 0.5 * sum;
 }
 
-void penetrationVolumeNormal(const TriangleMesh& ma, const TriangleMesh& mb, const Pose& xfAFromB,
-                             QueryScratch::Impl& s, Vec3& normal, double& depth) {
+// Normal and depth of every patch (s.patchNormal, s.patchDepth), each from its own pairs only:
+// a triangle is clipped by the half-spaces of the other body's triangles it meets in that patch.
+// A patch whose area vectors cancel keeps B's face normal of its first pair (B toward A).
+void penetrationVolumeNormals(const TriangleMesh& ma, const TriangleMesh& mb, const Pose& xfAFromB,
+                              std::uint32_t patchCount, QueryScratch::Impl& s) {
   auto& pairs = s.volumePairs;
+  s.patchNormal.assign(patchCount, Vec3::Zero());
+  s.patchDepth.assign(patchCount, 0.0);
   if (pairs.empty()) return;
-  depth = 0.0;
-  Vec3 sum = Vec3::Zero();
-  Vec3 centroidA = Vec3::Zero(), centroidB = Vec3::Zero();
-  double areaA = 0.0, areaB = 0.0;
+  // patchNormal accumulates the area-vector sums.
+  auto& sums = s.patchSums;
+  sums.assign(patchCount, {Vec3::Zero(), Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.0, false});
+  for (std::size_t i = 0; i < pairs.size(); ++i) {  // still in insertion order
+    auto& q = sums[pairs[i].patch];
+    if (!q.seen) q.fallbackNormal = s.pairNormalB[i];
+    q.seen = true;
+  }
   const Pose xfBFromA = xfAFromB.inverse();
-  // A's triangles, each clipped by the B triangles it meets (pairs sorted by A's triangle).
-  std::sort(pairs.begin(), pairs.end());
+  // A's triangles, each clipped by the B triangles it meets in its patch.
+  std::sort(pairs.begin(), pairs.end(), [](const auto& x, const auto& y) {
+    return x.patch != y.patch ? x.patch < y.patch : (x.ta != y.ta ? x.ta < y.ta : x.tb < y.tb);
+  });
   for (std::size_t i = 0; i < pairs.size();) {
     std::size_t j = i;
     s.clippers.clear();
-    while (j < pairs.size() && pairs[j][0] == pairs[i][0]) s.clippers.push_back(pairs[j++][1]);
-    const std::uint32_t t = pairs[i][0];
+    while (j < pairs.size() && pairs[j].patch == pairs[i].patch && pairs[j].ta == pairs[i].ta) {
+      s.clippers.push_back(pairs[j++].tb);
+    }
+    const std::uint32_t t = pairs[i].ta;
+    const std::uint32_t patch = pairs[i].patch;
     clipByHalfSpaces(ma.corner(t, 0), ma.corner(t, 1), ma.corner(t, 2), mb, xfAFromB, s.clippers, s.poly, s.polyTmp);
-    sum -= polygonAreaVector(s.poly);  // its area vector is n_A * area (counter-clockwise)
-    accumulateCentroid(s.poly, Pose{}, centroidA, areaA);
+    s.patchNormal[patch] -= polygonAreaVector(s.poly);  // its area vector is n_A * area (counter-clockwise)
+    accumulateCentroid(s.poly, Pose{}, sums[patch].centroidA, sums[patch].areaA);
     i = j;
   }
-  // B's triangles, clipped by the A triangles they meet, in B's frame, then moved to A's.
-  std::sort(pairs.begin(), pairs.end(), [](const auto& x, const auto& y) { return x[1] != y[1] ? x[1] < y[1] : x[0] < y[0]; });
+  // B's triangles, clipped by the A triangles they meet in the patch, in B's frame, then moved to A's.
+  std::sort(pairs.begin(), pairs.end(), [](const auto& x, const auto& y) {
+    return x.patch != y.patch ? x.patch < y.patch : (x.tb != y.tb ? x.tb < y.tb : x.ta < y.ta);
+  });
   for (std::size_t i = 0; i < pairs.size();) {
     std::size_t j = i;
     s.clippers.clear();
-    while (j < pairs.size() && pairs[j][1] == pairs[i][1]) s.clippers.push_back(pairs[j++][0]);
-    const std::uint32_t t = pairs[i][1];
+    while (j < pairs.size() && pairs[j].patch == pairs[i].patch && pairs[j].tb == pairs[i].tb) {
+      s.clippers.push_back(pairs[j++].ta);
+    }
+    const std::uint32_t t = pairs[i].tb;
+    const std::uint32_t patch = pairs[i].patch;
     clipByHalfSpaces(mb.corner(t, 0), mb.corner(t, 1), mb.corner(t, 2), ma, xfBFromA, s.clippers, s.poly, s.polyTmp);
-    sum += xfAFromB.rotation * polygonAreaVector(s.poly);
-    accumulateCentroid(s.poly, xfAFromB, centroidB, areaB);
+    s.patchNormal[patch] += xfAFromB.rotation * polygonAreaVector(s.poly);
+    accumulateCentroid(s.poly, xfAFromB, sums[patch].centroidB, sums[patch].areaB);
     i = j;
   }
-  const double len = sum.norm();
-  if (len > 0.0) normal = sum / len;
-  if (areaA > 0.0 && areaB > 0.0) depth = std::max(0.0, normal.dot(centroidB / areaB - centroidA / areaA));
+  for (std::uint32_t p = 0; p < patchCount; ++p) {
+    const double len = s.patchNormal[p].norm();
+    const auto& q = sums[p];
+    s.patchNormal[p] = len > 0.0 ? Vec3(s.patchNormal[p] / len) : q.fallbackNormal;
+    if (q.areaA > 0.0 && q.areaB > 0.0) {
+      s.patchDepth[p] = std::max(0.0, s.patchNormal[p].dot(q.centroidB / q.areaB - q.centroidA / q.areaA));
+    }
+  }
+}
+
+std::uint32_t findPatchRoot(std::vector<std::uint32_t>& parent, std::uint32_t i) {
+  while (parent[i] != i) {
+    parent[i] = parent[parent[i]];  // path halving
+    i = parent[i];
+  }
+  return i;
+}
+
+// Groups the intersecting triangle pairs into connected patches: two pairs belong to one patch
+// when their intersection points (segment ends, overlap-polygon corners) coincide within `tol`
+// and both are coplanar (face-on-face touching) or both are crossing. Where the intersection
+// curve of two closed meshes passes from one triangle into the next, the two pairs compute the
+// same crossing point, so a connected curve (or overlap region) chains into one patch, while
+// separate touching regions stay apart even when they share a large triangle (a box's 2-triangle
+// face touching both the ground and a bump). Flush coplanar regions are kept apart from crossing
+// ones: a flush face contact says "touching along the face normal, depth 0", and merged with a
+// bump it would dilute the bump's normal and depth over the whole face (docs/narrow-phase.md).
+// Points are hashed into cells of 64 tol and sorted by cell: points of one cell are compared with
+// each other, and a point within tol of a cell face also with the neighbour cell(s) across it
+// (rare: ~3 % per axis), so the cost is one sort, O(k log k), not 27 look-ups per point.
+// Returns the patch count; sets volumePairs[i].patch (insertion order) to 0 .. count-1.
+std::uint32_t groupPatches(QueryScratch::Impl& s, double tol) {
+  const std::size_t n = s.volumePairs.size();
+  s.patchParent.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) s.patchParent[i] = i;
+  const double cellSize = 64.0 * tol;
+  s.cellPoints.clear();
+  for (std::uint32_t k = 0; k < s.exactContacts.size(); ++k) {
+    const Vec3 q = s.exactContacts[k].contact.point / cellSize;
+    s.cellPoints.push_back({{static_cast<std::int64_t>(std::floor(q.x())), static_cast<std::int64_t>(std::floor(q.y())),
+                             static_cast<std::int64_t>(std::floor(q.z()))},
+                            k});
+  }
+  std::sort(s.cellPoints.begin(), s.cellPoints.end(),
+            [](const auto& x, const auto& y) { return x.cell != y.cell ? x.cell < y.cell : x.contact < y.contact; });
+  const double tol2 = tol * tol;
+  auto join = [&](std::uint32_t ci, std::uint32_t cj) {
+    const auto& x = s.exactContacts[ci];
+    const auto& y = s.exactContacts[cj];
+    if (x.pair == y.pair || s.pairCoplanar[x.pair] != s.pairCoplanar[y.pair]) return;
+    if ((x.contact.point - y.contact.point).squaredNorm() > tol2) return;
+    const std::uint32_t ra = findPatchRoot(s.patchParent, x.pair);
+    const std::uint32_t rb = findPatchRoot(s.patchParent, y.pair);
+    if (ra != rb) s.patchParent[std::max(ra, rb)] = std::min(ra, rb);
+  };
+  const std::size_t m = s.cellPoints.size();
+  for (std::size_t i = 0; i < m; ++i) {
+    const auto& cp = s.cellPoints[i];
+    // Same cell: the points after it in the run.
+    for (std::size_t j = i + 1; j < m && s.cellPoints[j].cell == cp.cell; ++j) join(cp.contact, s.cellPoints[j].contact);
+    // Neighbour cells across the faces it is within tol of (each such pair is seen from both
+    // sides; joining twice is harmless).
+    const Vec3 q = s.exactContacts[cp.contact].contact.point / cellSize;
+    std::array<std::int64_t, 3> lo{}, hi{};
+    bool near = false;
+    for (int d = 0; d < 3; ++d) {
+      const double frac = q[d] - static_cast<double>(cp.cell[static_cast<std::size_t>(d)]);
+      lo[static_cast<std::size_t>(d)] = frac * cellSize <= tol ? -1 : 0;
+      hi[static_cast<std::size_t>(d)] = (1.0 - frac) * cellSize <= tol ? 1 : 0;
+      near = near || lo[static_cast<std::size_t>(d)] != 0 || hi[static_cast<std::size_t>(d)] != 0;
+    }
+    if (!near) continue;
+    for (std::int64_t dx = lo[0]; dx <= hi[0]; ++dx) {
+      for (std::int64_t dy = lo[1]; dy <= hi[1]; ++dy) {
+        for (std::int64_t dz = lo[2]; dz <= hi[2]; ++dz) {
+          if (dx == 0 && dy == 0 && dz == 0) continue;
+          const std::array<std::int64_t, 3> cell{cp.cell[0] + dx, cp.cell[1] + dy, cp.cell[2] + dz};
+          auto it = std::lower_bound(s.cellPoints.begin(), s.cellPoints.end(), cell,
+                                     [](const auto& x, const auto& c) { return x.cell < c; });
+          for (; it != s.cellPoints.end() && it->cell == cell; ++it) join(cp.contact, it->contact);
+        }
+      }
+    }
+  }
+  // Number the patches in order of their first pair, so the numbering is deterministic.
+  std::uint32_t count = 0;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const std::uint32_t r = findPatchRoot(s.patchParent, i);
+    if (r == i) s.volumePairs[i].patch = count++;
+  }
+  for (std::uint32_t i = 0; i < n; ++i) s.volumePairs[i].patch = s.volumePairs[findPatchRoot(s.patchParent, i)].patch;
+  return count;
 }
 
 // Returns true if every frontier pair got its triangle tests.
@@ -717,6 +846,8 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
   s.trianglePairs.clear();
   s.exactContacts.clear();
   s.volumePairs.clear();
+  s.pairCoplanar.clear();
+  s.pairNormalB.clear();
   hits.clear();
   bool complete = traversalFinished;
   if (traversalFinished) {
@@ -769,7 +900,10 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
         // Coplanar triangles facing the same way are flush side by side (two boxes' aligned side
         // faces), not pressed against each other: no contact.
         if (hit.coplanar && hit.normalA.dot(hit.normalB) > 0.0) continue;
-        s.volumePairs.push_back({ref.ta, ref.tb});
+        const auto pairIndex = static_cast<std::uint32_t>(s.volumePairs.size());
+        s.volumePairs.push_back({ref.ta, ref.tb, 0});
+        s.pairCoplanar.push_back(hit.coplanar ? 1 : 0);
+        s.pairNormalB.push_back(hit.normalB);
         // Normal and depth are filled in below, once all intersecting pairs are known.
         const std::uint64_t key = (std::uint64_t{ref.ta} << 32) | ref.tb;
         Contact c;
@@ -777,7 +911,7 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
         c.level = std::max(bodyA.sphereLevel(front[i].a), bodyB.sphereLevel(front[i].b));
         for (std::uint32_t q = 0; q < hit.count; ++q) {
           c.point = hit.points[q];
-          s.exactContacts.push_back({key, c});
+          s.exactContacts.push_back({key, pairIndex, c});
         }
       }
       if (complete) s.pairDone[i] = 1;
@@ -788,12 +922,19 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
     std::stable_sort(s.exactContacts.begin(), s.exactContacts.end(),
                      [](const auto& x, const auto& y) { return x.key < y.key; });
   }
-  Vec3 normal = Vec3::UnitZ();
-  double depth = 0.0;
-  penetrationVolumeNormal(ma, mb, xfAFromB, s, normal, depth);
+  // Per patch normal and depth. Patch tolerance: far above the rounding of intersection points
+  // computed by two pairs (~1e-16 relative, more for nearly parallel planes), far below any
+  // feature size: 1e-7 of the bodies' size.
+  const double patchTol = 1e-7 * (bodyA.diagonal() + bodyB.diagonal());
+  const std::uint32_t patches = groupPatches(s, patchTol);
+  // The pairs' patch numbers in insertion order, before penetrationVolumeNormals sorts them.
+  s.patchParent.resize(s.volumePairs.size());
+  for (std::size_t i = 0; i < s.volumePairs.size(); ++i) s.patchParent[i] = s.volumePairs[i].patch;
+  penetrationVolumeNormals(ma, mb, xfAFromB, patches, s);
   for (auto& kc : s.exactContacts) {
-    kc.contact.normal = normal;
-    kc.contact.depth = depth;
+    const std::uint32_t patch = s.patchParent[kc.pair];
+    kc.contact.normal = s.patchNormal[patch];
+    kc.contact.depth = s.patchDepth[patch];
     out.push_back(kc.contact);
   }
   std::sort(hits.begin(), hits.end());

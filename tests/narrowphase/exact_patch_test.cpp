@@ -1,0 +1,139 @@
+// The exact model's per-patch normals and depths against an analytic scene: a cube pressed
+// face-down into a slab while a small raised block (a separate closed part of the slab's mesh,
+// not touching the slab) presses into the cube's front face. The two touching regions are two
+// patches; each must carry its own face normal and its own depth.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "clod/primitives.h"
+#include "clod/query.h"
+#include "narrowphase_test_support.h"
+
+namespace clod {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegree = kPi / 180.0;
+
+double angleBetween(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
+
+// Appends `part`, moved by `offset`, to `mesh` as a separate closed component.
+void appendMoved(TriangleMesh& mesh, const TriangleMesh& part, const Vec3& offset) {
+  const auto base = mesh.vertexCount();
+  for (const Vec3& v : part.vertices) mesh.vertices.push_back(v + offset);
+  for (const Triangle& t : part.triangles) mesh.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+}
+
+// Scene (B at the origin): slab |x|, |y| <= 3, -1 <= z <= 0; block 0.4 x 0.4 x 0.4 at
+// z in [0.3, 0.7], its -x face at x = 1 - kBlockPenetration. Cube A (half extent 1) at
+// (0, 0, 1 - kSlabPenetration): its bottom is kSlabPenetration below the slab's top, its +x face
+// kBlockPenetration behind the block's -x face. The block does not reach down to the slab, so
+// the two intersection curves (one around the cube at z = 0, one around the block on the cube's
+// +x face) are apart, but both run over the cube's two +x-face triangles.
+constexpr double kSlabPenetration = 0.01;
+constexpr double kBlockPenetration = 0.04;
+constexpr double kBlockBottom = 0.3;
+
+struct Scene {
+  CollisionBody cube, ground;
+  Scene()
+      : cube(test::makeTestBody(makeBox(Vec3::Constant(1.0)), 2, false, false)),
+        ground(test::makeTestBody(makeGround(), 2, false, false)) {}
+  static TriangleMesh makeGround() {
+    TriangleMesh mesh;
+    appendMoved(mesh, makeBox(Vec3(3.0, 3.0, 0.5)), Vec3(0.0, 0.0, -0.5));
+    appendMoved(mesh, makeBox(Vec3::Constant(0.2)), Vec3(1.0 - kBlockPenetration + 0.2, 0.0, kBlockBottom + 0.2));
+    return mesh;
+  }
+};
+
+const Scene& scene() {
+  static const Scene s;
+  return s;
+}
+
+Pose cubePose() {
+  Pose p;
+  p.translation = Vec3(0.0, 0.0, 1.0 - kSlabPenetration);
+  return p;
+}
+
+QuerySettings exactSettings(std::uint32_t maxContacts) {
+  QuerySettings s;
+  s.model = ContactModel::kExact;
+  s.budget.maxTests = kUnlimitedTests;
+  s.maxContacts = maxContacts;
+  s.mergeDistanceRel = 0.0;
+  return s;
+}
+
+// Normals point from B (ground) toward A (cube): the slab's top pushes the cube up (+z), the
+// block's -x face pushes it back (-x). Depth, analytically: the model's depth is the distance
+// along the normal between the area centroids of the two inside surfaces (query.h). At the slab,
+// the cube's inside surface is its four side strips of height kSlabPenetration (the bottom lies
+// wholly inside the slab and crosses nothing, so it does not count: docs/narrow-phase.md),
+// centroid at z = -kSlabPenetration / 2, and the slab's is the 2 x 2 square at z = 0: depth
+// kSlabPenetration / 2. At the block, likewise kBlockPenetration / 2. Tolerance: 1e-9 of the
+// scene's ~8.5 m diagonal, far above rounding, far below the 5 mm between the two depths.
+constexpr double kDepthTolerance = 1e-8;
+
+TEST(ExactModelPatches, SlabAndRaisedBlockGiveTwoPatchesWithTheirOwnNormalAndDepth) {
+  const Scene& s = scene();
+  // Every raw contact (no reduction): classify each by where it lies.
+  const QueryResult all = queryContacts(s.cube, cubePose(), s.ground, Pose{}, exactSettings(100000));
+  ASSERT_TRUE(all.finished);
+  ASSERT_TRUE(all.colliding);
+  // (Coincident copies of a point, from neighbouring triangle pairs, are merged: 0 distance.)
+  int slabContacts = 0, blockContacts = 0;
+  for (const Contact& c : all.contacts) {
+    // Slab contacts lie on the slab's top (z = 0, down to the cube's bottom); block contacts on
+    // the cube's +x face between the block's bottom and top.
+    const bool onBlock = c.point.z() > kBlockBottom - 1e-6;
+    if (onBlock) {
+      ++blockContacts;
+      EXPECT_NEAR(c.point.x(), 1.0 - 0.5 * kBlockPenetration, 0.5 * kBlockPenetration + 1e-9) << c.point.transpose();
+      EXPECT_LT(angleBetween(c.normal, -Vec3::UnitX()), 2.0 * kDegree) << c.normal.transpose();
+      EXPECT_NEAR(c.depth, 0.5 * kBlockPenetration, kDepthTolerance) << c.point.transpose();
+    } else {
+      ++slabContacts;
+      EXPECT_NEAR(c.point.z(), -0.5 * kSlabPenetration, 0.5 * kSlabPenetration + 1e-9) << c.point.transpose();
+      EXPECT_LT(angleBetween(c.normal, Vec3::UnitZ()), 2.0 * kDegree) << c.normal.transpose();
+      EXPECT_NEAR(c.depth, 0.5 * kSlabPenetration, kDepthTolerance) << c.point.transpose();
+    }
+  }
+  EXPECT_GE(slabContacts, 3);   // the cube's footprint on the slab
+  EXPECT_GE(blockContacts, 3);  // the block's cross-section on the cube's face
+
+  // A manifold of 8 keeps the deepest (block) patch and spreads onto the slab's patch too, each
+  // contact still carrying its own patch's normal.
+  const QueryResult reduced = queryContacts(s.cube, cubePose(), s.ground, Pose{}, exactSettings(8));
+  int up = 0, back = 0;
+  for (const Contact& c : reduced.contacts) {
+    if (angleBetween(c.normal, Vec3::UnitZ()) < 2.0 * kDegree) ++up;
+    if (angleBetween(c.normal, -Vec3::UnitX()) < 2.0 * kDegree) ++back;
+  }
+  EXPECT_EQ(up + back, static_cast<int>(reduced.contacts.size()));
+  EXPECT_GE(up, 1);
+  EXPECT_GE(back, 1);
+  ASSERT_FALSE(reduced.contacts.empty());
+  EXPECT_NEAR(reduced.contacts.front().depth, 0.5 * kBlockPenetration, kDepthTolerance);  // deepest first
+}
+
+// The same scene with the block moved off the cube: one patch, the slab's, as before.
+TEST(ExactModelPatches, WithoutTheBlockOnlyTheSlabPatchRemains) {
+  const Scene& s = scene();
+  Pose pose = cubePose();
+  pose.translation.x() -= 2.0 * kBlockPenetration;  // the cube's +x face now 4 cm short of the block
+  const QueryResult r = queryContacts(s.cube, pose, s.ground, Pose{}, exactSettings(100000));
+  ASSERT_TRUE(r.finished);
+  ASSERT_FALSE(r.contacts.empty());
+  for (const Contact& c : r.contacts) {
+    EXPECT_LT(angleBetween(c.normal, Vec3::UnitZ()), 2.0 * kDegree) << c.normal.transpose();
+    EXPECT_NEAR(c.depth, 0.5 * kSlabPenetration, kDepthTolerance);
+  }
+}
+
+}  // namespace
+}  // namespace clod
