@@ -98,16 +98,10 @@ TEST(ExperimentFlatContactCli, JsonHasRestAndBumpRowsPerModelAndWritesTablesAndP
   fs::remove_all(dir);
 }
 
-// Known failure (docs/dynamics.md, Known limits): the exact reference box ploughs through the 4 cm
-// bump (lift 0-1.6 mm). Not a world regression -- src/dynamics is identical at 02bdb86 and acc430c
-// -- but the exact model's one normal and one depth per pair: while the box's bottom lies flush on
-// the flat ground, that coplanar patch dominates the intersection-volume normal (vertical) and the
-// depth (the bump's volume spread over the 1 m^2 face, ~1.5 mm, under the slop), so nothing lifts
-// the box. Whether it rides over depends on whether it happens to lose the flush contact: the same
-// box and bump in 'clod simulate' (20 iterations, density 1000) loses it and rises 19 mm; with
-// the experiment's settings (100 iterations) it stays flush. Needs per-patch normals and depths
-// from the narrow phase.
-// Enable with --gtest_also_run_disabled_tests.
+// The reference animation must show the bump's effect: the exact model gives each connected
+// contact patch its own normal and depth (07e55db), so the bump's patch lifts the box while the
+// flush patch on the flat ground holds it up (with one normal and depth per pair the flush patch
+// dominated both, and the box ploughed through: docs/narrow-phase.md, "Patches").
 TEST(ExperimentFlatContactCli, ReferenceBoxRisesOverTheBumpButNotOnFlatGround) {
   const clod::test::CliRun run = runCli("experiment flat-contact --trials 1 --json");
   ASSERT_EQ(run.exitCode, 0) << run.err;
