@@ -87,7 +87,9 @@ TEST(ExperimentLandingCli, ReportsBothScenariosForDosCfmAndExactAndWritesTimeSer
     EXPECT_LE(row["max_normal_tilt_deg"]["max"].get<double>(), 90.0);
     // Every body lands within the second (it starts at most 10 cm above the box).
     EXPECT_GT(row["contact_steps"]["mean"].get<double>(), 0.0) << row.dump();
-    if (model == "exact") EXPECT_EQ(row["orientation_error_deg"]["mean"].get<double>(), 0.0);
+    if (model == "exact") {
+      EXPECT_EQ(row["orientation_error_deg"]["mean"].get<double>(), 0.0);
+    }
   }
   EXPECT_EQ(seen.size(), drops["rows"].size());
   const std::string series = readFile(dir / "landing_bunny.csv");
