@@ -17,9 +17,11 @@ pages=(proximity sphere_tree bake sampling cfm contact_tree sdfbake narrowphase 
     [ -f "$f" ] || continue
     echo "---"
     echo
-    # Demote headings one level so each page becomes a section; relative image links are
-    # rewritten to point into docs/benchmarks/ from the repository root.
-    sed -e 's/^#/##/' -e 's/](\([A-Za-z0-9_.-]*\.\(png\|svg\)\))/](docs\/benchmarks\/\1)/g' "$f"
+    # Demote headings one level so each page becomes a section (not `#` lines inside fenced
+    # code blocks: shell comments); relative image links are rewritten to point into
+    # docs/benchmarks/ from the repository root.
+    awk '/^```/ { fenced = !fenced } !fenced && /^#/ { $0 = "#" $0 } { print }' "$f" |
+      sed -e 's/](\([A-Za-z0-9_.-]*\.\(png\|svg\)\))/](docs\/benchmarks\/\1)/g'
     echo
   done
 } > BENCHMARKS.md.tmp
