@@ -133,24 +133,20 @@ TEST(BakeCorruption, BrokenSphereTreeInvariantsAreCorruptionNamingTheField) {
   EXPECT_NO_THROW(decodeBake(fileWithSphereTree(contents, good)));
 }
 
-TEST(BakeCorruption, UnknownSphereTreeMethodIsCorruption) {
-  BakeContents contents = makeTestContents();
-  BakeFileWriter writer;
-  writer.addSection(kBakeMeshTag, kBakeMeshVersion, detail::encodeMeshSection(contents.mesh, meshContentHash(contents.mesh), ""));
-  contents.sphereTreeSettings.method = static_cast<SphereTreeMethod>(7);
-  writer.addSection(kBakeSphereTreeTag, kBakeSphereTreeVersion,
-                    detail::encodeSphereTreeSection(contents.sphereTree, contents.sphereTreeSettings));
-  expectCorruptMentioning(writer.encode(), "method");
-}
-
-TEST(BakeCorruption, UnknownMedialReductionIsCorruption) {
-  BakeContents contents = makeTestContents();
-  BakeFileWriter writer;
-  writer.addSection(kBakeMeshTag, kBakeMeshVersion, detail::encodeMeshSection(contents.mesh, meshContentHash(contents.mesh), ""));
-  contents.sphereTreeSettings.medialReduction = static_cast<MedialReduction>(3);
-  writer.addSection(kBakeSphereTreeTag, kBakeSphereTreeVersion,
-                    detail::encodeSphereTreeSection(contents.sphereTree, contents.sphereTreeSettings));
-  expectCorruptMentioning(writer.encode(), "medial reduction");
+TEST(BakeCorruption, UnknownSphereTreeMethodOrMedialReductionIsCorruption) {
+  const BakeContents contents = makeTestContents();
+  auto fileWithSettings = [&](const SphereTreeSettings& settings) {
+    BakeFileWriter writer;
+    writer.addSection(kBakeMeshTag, kBakeMeshVersion, detail::encodeMeshSection(contents.mesh, meshContentHash(contents.mesh), ""));
+    writer.addSection(kBakeSphereTreeTag, kBakeSphereTreeVersion, detail::encodeSphereTreeSection(contents.sphereTree, settings));
+    return writer.encode();
+  };
+  SphereTreeSettings badMethod = contents.sphereTreeSettings;
+  badMethod.method = static_cast<SphereTreeMethod>(7);
+  expectCorruptMentioning(fileWithSettings(badMethod), "method");
+  SphereTreeSettings badReduction = contents.sphereTreeSettings;
+  badReduction.medialReduction = static_cast<MedialReduction>(3);
+  expectCorruptMentioning(fileWithSettings(badReduction), "medial reduction");
 }
 
 TEST(BakeCorruption, BrokenMeshInvariantsAreCorruptionNamingTheCulprit) {
