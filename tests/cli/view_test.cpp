@@ -10,11 +10,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -33,10 +34,15 @@ struct HttpReply {
   int status = 0;
   std::string head;
   std::string body;
+  // The value of header `name` (case-insensitive), or "" if absent.
   std::string header(const std::string& name) const {
-    const std::regex re("\r\n" + name + ": ([^\r]*)\r\n", std::regex::icase);
-    std::smatch m;
-    return std::regex_search(head, m, re) ? m[1].str() : std::string();
+    std::string lowerHead = head, key = "\r\n" + name + ": ";
+    for (std::string* t : {&lowerHead, &key})
+      std::transform(t->begin(), t->end(), t->begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    const std::size_t at = lowerHead.find(key);
+    if (at == std::string::npos) return std::string();
+    const std::size_t begin = at + key.size();
+    return head.substr(begin, head.find('\r', begin) - begin);
   }
 };
 
@@ -118,9 +124,12 @@ Server startServer(const std::vector<std::string>& args) {
   }
   ::close(out[0]);  // the server's later lines go nowhere; it ignores SIGPIPE
   server.firstLine = text.substr(0, text.find('\n'));
-  std::smatch m;
-  const std::regex url(R"(http://127\.0\.0\.1:(\d+)/)");
-  if (std::regex_search(server.firstLine, m, url)) server.port = std::stoi(m[1].str());
+  const std::string prefix = "http://127.0.0.1:";
+  const std::size_t at = server.firstLine.find(prefix);
+  if (at != std::string::npos) {
+    const char* digits = server.firstLine.c_str() + at + prefix.size();
+    if (std::isdigit(static_cast<unsigned char>(*digits))) server.port = std::atoi(digits);
+  }
   return server;
 }
 
