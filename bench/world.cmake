@@ -7,12 +7,4 @@ target_link_libraries(world_compare PRIVATE clod::clod)
 target_compile_definitions(world_compare PRIVATE CLOD_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
                                                  CLOD_BINARY_DIR="${PROJECT_BINARY_DIR}")
 clod_target_defaults(world_compare)
-if(BULLET_FOUND)
-  # BULLET_LIBRARIES are Debian's single-precision libraries (btScalar = float).
-  target_include_directories(world_compare SYSTEM PRIVATE ${BULLET_INCLUDE_DIRS})
-  target_link_libraries(world_compare PRIVATE ${BULLET_LIBRARIES})
-  target_compile_definitions(world_compare PRIVATE CLOD_BENCH_HAVE_BULLET=1)
-  message(STATUS "world_compare: comparing with Bullet")
-else()
-  message(STATUS "world_compare: Bullet not found, peer rows skipped")
-endif()
+clod_bench_link_bullet(world_compare "Bullet (GImpact and convex hulls)")

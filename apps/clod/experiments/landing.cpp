@@ -626,16 +626,16 @@ ExperimentResult runLanding(const ExperimentOptions& options) {
     }
     return std::nan("");
   };
+  // "a / b / c": one statistic of one shape and model at sphere levels 0, 1 and 3.
+  auto atLevels013 = [&](const char* shape, const char* model, const char* stat) {
+    return num(dropStat(shape, model, 0, stat), 1) + " / " + num(dropStat(shape, model, 1, stat), 1) + " / " +
+           num(dropStat(shape, model, 3, stat), 1);
+  };
   html << "<p><b>Why cfm is not closer to exact here, from the contacts.</b> The CFM normal is used and it is right: "
           "cfm's contact normals are off the box's face normal by "
-       << num(dropStat("cube", "cfm", 0, "normal_tilt_deg"), 1) << " / " << num(dropStat("cube", "cfm", 1, "normal_tilt_deg"), 1)
-       << " / " << num(dropStat("cube", "cfm", 3, "normal_tilt_deg"), 1) << " deg for the cube at levels 0 / 1 / 3 and "
-       << num(dropStat("bunny", "cfm", 0, "normal_tilt_deg"), 1) << " / " << num(dropStat("bunny", "cfm", 1, "normal_tilt_deg"), 1)
-       << " / " << num(dropStat("bunny", "cfm", 3, "normal_tilt_deg"), 1) << " deg for the bunny, against dos's "
-       << num(dropStat("cube", "dos", 0, "normal_tilt_deg"), 1) << " / " << num(dropStat("cube", "dos", 1, "normal_tilt_deg"), 1)
-       << " / " << num(dropStat("cube", "dos", 3, "normal_tilt_deg"), 1) << " and "
-       << num(dropStat("bunny", "dos", 0, "normal_tilt_deg"), 1) << " / " << num(dropStat("bunny", "dos", 1, "normal_tilt_deg"), 1)
-       << " / " << num(dropStat("bunny", "dos", 3, "normal_tilt_deg"), 1)
+       << atLevels013("cube", "cfm", "normal_tilt_deg") << " deg for the cube at levels 0 / 1 / 3 and "
+       << atLevels013("bunny", "cfm", "normal_tilt_deg") << " deg for the bunny, against dos's "
+       << atLevels013("cube", "dos", "normal_tilt_deg") << " and " << atLevels013("bunny", "dos", "normal_tilt_deg")
        << " deg (dos's normal is the line between sphere centres, so it is not the same as cfm's on this geometry). "
           "What decides the landing is where the contacts are, and both models take the contact point and depth from "
           "the sphere overlap (D&amp;O). With exact contacts the cube's tilt changes by "
