@@ -47,7 +47,9 @@
 // wholly inside the other body, e.g. a box's bottom sunk into a slab, it crosses nothing and does
 // not count, and the depth is half the penetration). A flush coplanar patch gets its face normal
 // and depth 0. Patch grouping costs O(k log k) for k contact points. Pairs of the frontier that
-// did not get that far (interrupted) give D&O contacts.
+// did not get that far (interrupted before or during the triangle tests) give cfm contacts when
+// both bodies carry closest feature maps (no extra tests; pairs a separating axis proves apart
+// give none), else D&O contacts.
 //
 // Contacts are finally reduced to a manifold (reduceManifold, contact.h).
 
@@ -101,8 +103,8 @@ struct FrontierPair {
 struct QueryResult {
   /// dos and average: the frontier is non-empty. cfm: at least one contact (pairs whose patches
   /// a separating axis proves apart give none, docs/narrow-phase.md). Contact tree: at least one
-  /// contact. Exact: a triangle pair intersects (or, if interrupted, some frontier pair was not
-  /// refuted).
+  /// contact. Exact: a triangle pair intersects (or, if interrupted: with closest feature maps on
+  /// both bodies at least one contact, as cfm; else some frontier pair was not refuted).
   bool colliding = false;
   /// The manifold, at most QuerySettings::maxContacts contacts, deepest first.
   std::vector<Contact> contacts;

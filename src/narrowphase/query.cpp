@@ -1043,15 +1043,23 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
           exactContacts(a, b, xfAFromB, s.sphereFront, finished, meter, s, s.raw, result.triangleTests,
                         result.intersectingTriangles);
       if (!complete) {
-        // Frontier pairs that did not get their triangle tests answer with D&O contacts.
+        // Frontier pairs that did not get their triangle tests answer from their spheres: as cfm
+        // does when both bodies carry closest feature maps (no tests: the maps and patches are
+        // looked up, not tested), else with D&O contacts. D&O normals follow the sphere centre
+        // lines and were as far off as dos's (bunny at 1024 tests: 19.8 deg median).
         s.sphereNext.clear();
         for (std::size_t i = 0; i < s.sphereFront.size(); ++i) {
           if (!s.pairDone[i]) s.sphereNext.push_back(s.sphereFront[i]);
         }
-        sphereContacts(ContactModel::kDos, a, b, xfAFromB, s.sphereNext, s.raw);
+        const ContactModel fallback =
+            a.hasClosestFeatureMap() && b.hasClosestFeatureMap() ? ContactModel::kCfm : ContactModel::kDos;
+        sphereContacts(fallback, a, b, xfAFromB, s.sphereNext, s.raw);
         finished = false;
+        // cfm drops pairs proven apart, as in the cfm model: then colliding means some contact.
+        result.colliding = fallback == ContactModel::kCfm ? !s.raw.empty() : !s.sphereFront.empty();
+      } else {
+        result.colliding = !s.raw.empty();
       }
-      result.colliding = complete ? !s.raw.empty() : !s.sphereFront.empty();
     } else {
       sphereContacts(model, a, b, xfAFromB, s.sphereFront, s.raw);
       // cfm drops pairs proven apart: colliding means some pair gave a contact.
