@@ -10,7 +10,11 @@
 //   world_compare [--scene FILE] [--cache DIR] [--steps N] [--models dos,cfm,contact-tree,exact]
 //                 [--budgets 1024,4096,16384,0] [--bullet gimpact,hull|none]
 //                 [--bullet-substeps 1,clod] [--bullet-steps N] [--bullet-iterations N]
-//                 [--row-seconds S]
+//                 [--row-seconds S] [--breakdown 1]
+// --breakdown 1 adds, after the table, per clod row the breakdown of the frames at the CPU median,
+// at the CPU 99th percentile and of the slowest frame: substeps, pairs, tests, the work the budget
+// does not count (frontier pairs sampled / turned into contacts, raw contacts, solver contacts)
+// and where the time went (StepReport's broad phase, narrow phase, prepare, solver, integrate).
 // --row-seconds (default 180, 0 = no cap) ends a row whose frames have taken S seconds of wall
 // time; the row then reports the steps it did ("37 of 240 (capped)") and its outcome columns
 // describe the pile at that step, not at the end.
@@ -77,6 +81,7 @@ struct Options {
   std::uint32_t bulletSteps = 0;  // 0 = same as clod
   int bulletIterations = 20;
   double rowSeconds = 180.0;  // a row stops after this much wall time (0 = never)
+  bool breakdown = false;
 };
 
 struct UsageError {
@@ -111,6 +116,7 @@ Options parseOptions(int argc, char** argv) {
     else if (flag == "--cache") o.cache = value;
     else if (flag == "--steps") o.steps = std::uint32_t(parseCount(flag, value));
     else if (flag == "--bullet-steps") o.bulletSteps = std::uint32_t(parseCount(flag, value));
+    else if (flag == "--breakdown") o.breakdown = parseCount(flag, value) != 0;
     else if (flag == "--row-seconds") {
       char* end = nullptr;
       o.rowSeconds = std::strtod(value.c_str(), &end);
@@ -158,13 +164,25 @@ double percentile(std::vector<double> v, double p) {
   return v[std::min(v.size(), std::max<std::size_t>(rank, 1)) - 1];
 }
 
+// One clod frame's StepReport figures (--breakdown).
+struct Frame {
+  std::uint32_t step = 0;
+  double cpu = 0.0;
+  std::uint32_t substeps = 0;
+  std::uint64_t candidatePairs = 0, tests = 0, spent = 0, skipped = 0, frontierPairs = 0, rawContacts = 0, solverContacts = 0;
+  std::uint32_t iterations = 0;
+  double broad = 0, narrow = 0, prepare = 0, solver = 0, integrate = 0;
+};
+
 // What a row reports. Outcome figures are measured the same way for clod and Bullet.
 struct Row {
+  std::vector<Frame> frames;  // clod rows
   std::string engine, model, budget;
   std::uint32_t steps = 0;    // asked for
   std::uint32_t stepsRun = 0; // done: fewer when the row hit --row-seconds
   std::vector<double> wall, cpu;
   std::uint64_t maxTests = 0;
+  std::uint64_t maxSpent = 0;  // StepReport::budgetSpent: tests + charged contact-tree sampling
   std::vector<double> substeps;
   std::uint32_t leftBounds = 0;   // centre of mass left the scene's bounds (then frozen/removed)
   std::uint32_t outsideBin = 0;   // dynamic bodies whose centre of mass ends outside the bin
@@ -262,6 +280,11 @@ Row runClod(const clod::World& tmpl, const clod::SceneDescription& scene, clod::
     row.wall.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     row.cpu.push_back(processCpuSeconds() - c0);
     row.maxTests = std::max(row.maxTests, r.testsSpent);
+    row.maxSpent = std::max(row.maxSpent, r.budgetSpent);
+    row.frames.push_back(Frame{s, row.cpu.back(), r.substeps, r.candidatePairs, r.testsSpent, r.budgetSpent, r.pairsSkipped,
+                               r.frontierPairs, r.rawContacts, r.solverContacts, r.solverIterations,
+                               r.broadPhaseSeconds, r.narrowPhaseSeconds, r.prepareSeconds, r.solverSeconds,
+                               r.integrateSeconds});
     row.substeps.push_back(r.substeps);
     row.leftBounds += std::uint32_t(r.leftBounds.size());
     row.stepsRun = s;
@@ -483,9 +506,9 @@ std::string withCommas(std::uint64_t v) {
 
 void printTable(const std::vector<Row>& rows) {
   std::cout << "| engine | model / shape | budget (tests/frame) | steps | substeps/frame (median) | median ms | p99 ms"
-                " | p99/median | max ms | CPU median ms | CPU p99 ms | CPU p99/median | max tests/frame | left bounds | outside bin at end"
+                " | p99/median | max ms | CPU median ms | CPU p99 ms | CPU p99/median | max tests/frame | max spent/frame | left bounds | outside bin at end"
                " | KE at end J | mean z at end m |\n"
-               "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+               "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
     const double med = 1e3 * percentile(r.wall, 0.5), p99 = 1e3 * percentile(r.wall, 0.99);
     const double mx = 1e3 * percentile(r.wall, 1.0);
@@ -498,8 +521,36 @@ void printTable(const std::vector<Row>& rows) {
               << fmt(med > 0 ? p99 / med : 0.0, 2) << " | " << fmt(mx, 2) << " | "
               << fmt(1e3 * cmed, 2) << " | " << fmt(1e3 * cp99, 2) << " | " << fmt(cmed > 0 ? cp99 / cmed : 0.0, 2)
               << " | "
-              << (r.engine == "clod" ? withCommas(r.maxTests) : std::string("-")) << " | " << r.leftBounds << " | "
+              << (r.engine == "clod" ? withCommas(r.maxTests) : std::string("-")) << " | "
+              << (r.engine == "clod" ? withCommas(r.maxSpent) : std::string("-")) << " | " << r.leftBounds << " | "
               << r.outsideBin << " | " << fmt(r.keEnd, 3) << " | " << fmt(r.meanZ, 3) << " |\n";
+  }
+  std::cout << std::flush;
+}
+
+// Per clod row: the frames at the CPU median and 99th percentile (nearest rank) and the slowest.
+void printBreakdown(const std::vector<Row>& rows) {
+  std::cout << "\nPer-frame breakdown (StepReport; times in ms, wall, summed over substeps):\n\n"
+               "| model | budget | frame | rank | CPU ms | substeps | candidate pairs | tests | budget spent | pairs skipped | frontier pairs"
+               " | raw contacts | solver contacts | solver iterations | broad ms | narrow ms | prepare ms | solver ms"
+               " | integrate ms |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const Row& r : rows) {
+    if (r.frames.empty()) continue;
+    std::vector<const Frame*> sorted;
+    for (const Frame& f : r.frames) sorted.push_back(&f);
+    std::stable_sort(sorted.begin(), sorted.end(), [](const Frame* x, const Frame* y) { return x->cpu < y->cpu; });
+    auto at = [&](double p) {
+      const std::size_t rank = std::size_t(std::ceil(p * double(sorted.size())));
+      return sorted[std::min(sorted.size(), std::max<std::size_t>(rank, 1)) - 1];
+    };
+    const std::pair<const char*, const Frame*> picks[] = {{"median", at(0.5)}, {"p99", at(0.99)}, {"max", at(1.0)}};
+    for (const auto& [name, f] : picks)
+      std::cout << "| " << r.model << " | " << r.budget << " | " << f->step << " | " << name << " | " << fmt(1e3 * f->cpu, 2)
+                << " | " << f->substeps << " | " << withCommas(f->candidatePairs) << " | " << withCommas(f->tests) << " | "
+                << withCommas(f->spent) << " | " << withCommas(f->skipped) << " | " << withCommas(f->frontierPairs) << " | " << withCommas(f->rawContacts)
+                << " | " << withCommas(f->solverContacts) << " | " << f->iterations << " | " << fmt(1e3 * f->broad, 2)
+                << " | " << fmt(1e3 * f->narrow, 2) << " | " << fmt(1e3 * f->prepare, 2) << " | "
+                << fmt(1e3 * f->solver, 2) << " | " << fmt(1e3 * f->integrate, 2) << " |\n";
   }
   std::cout << std::flush;
 }
@@ -551,6 +602,7 @@ int run(const Options& o) {
   }
   std::cout << "\nAll rows:\n\n";
   printTable(rows);
+  if (o.breakdown) printBreakdown(rows);
   return 0;
 }
 
@@ -564,7 +616,7 @@ int main(int argc, char** argv) {
     std::cerr << "usage: world_compare [--scene FILE] [--cache DIR] [--steps N] [--models dos,cfm,contact-tree,exact|none]\n"
                  "                     [--budgets 1024,4096,16384,unlimited] [--bullet gimpact,hull|none]\n"
                  "                     [--bullet-substeps 1,clod] [--bullet-steps N] [--bullet-iterations N]\n"
-                 "                     [--row-seconds S]\n";
+                 "                     [--row-seconds S] [--breakdown 1]\n";
     return e.message.empty() ? 0 : 2;
   } catch (const clod::Error& e) {
     std::cerr << "world_compare: " << e.what() << '\n';

@@ -31,7 +31,12 @@
 // pairs after it. When the budget is gone, the remaining pairs are not queried: they keep their
 // last contacts (graceful fallback) and are reported as skipped. Each pair keeps a
 // CoherenceCache, so an interrupted pair resumes from the level it reached next time. Hence a
-// step makes at most budgetTests tests.
+// step makes at most budgetTests tests. The contact tree also samples every frontier cell pair
+// of its answer, tested or not; that work is charged too (WorldSettings::sampledCellPairCost per
+// cell pair), and a query is given only as many tests as keep its frontier -- at most
+// max(cached front, tests) pairs -- within what it may spend: a pair whose cached front costs
+// more than the substep has left waits for the next substep (it is then ranked first), and one
+// whose front costs more than a whole substep's share restarts from the roots.
 //
 // Energy: the velocity solve is checked -- if the warm-started solve ends with more kinetic energy
 // than it started with, it is redone from zero impulses -- and the restitution impulses are scaled
@@ -64,6 +69,14 @@ struct WorldSettings {
   /// substeps together; 0 = unlimited. A step never spends more. Each substep gets an equal
   /// share of what the step has left (rounded up); what it does not spend rolls over.
   std::uint64_t budgetTests = 0;
+  /// Budget units charged per frontier cell pair a contact-tree query samples (0..1024). The
+  /// contact tree turns every cell pair of its answer frontier into contacts by sampling, tested
+  /// this query or kept from the pair's CoherenceCache, so without this charge its frame cost
+  /// grows with the frontier and the substep count, not with the budget (docs/dynamics.md,
+  /// "Collision budget per frame", has the measurement). The budget then counts tests +
+  /// sampledCellPairCost x sampled cell pairs (StepReport::budgetSpent). 0 = only tests count
+  /// (the behaviour before). Other models ignore it.
+  std::uint32_t sampledCellPairCost = 1;
   /// Manifold size per pair (QuerySettings::maxContacts), >= 1.
   std::uint32_t maxContacts = 8;
   /// Velocity iterations of the sequential-impulse solver (>= 1); position iterations likewise.
@@ -111,6 +124,9 @@ struct StepReport {
   std::uint64_t candidatePairs = 0;  ///< broad-phase pairs, summed over substeps
   std::uint64_t testsSpent = 0;      ///< narrow-phase tests, all pairs and substeps
   std::uint64_t testsBudget = 0;     ///< WorldSettings::budgetTests (0 = unlimited); testsSpent <= it
+  /// What the budget counted: testsSpent + WorldSettings::sampledCellPairCost x the cell pairs the
+  /// contact-tree queries sampled (= testsSpent for the other models); <= testsBudget when limited.
+  std::uint64_t budgetSpent = 0;
   std::uint64_t pairsSkipped = 0;    ///< pair queries skipped for lack of budget, summed
   std::uint64_t pairsInterrupted = 0;///< queries that stopped before the leaves, summed
   std::uint32_t solverIterations = 0;///< velocity iterations used, summed over substeps
@@ -119,6 +135,18 @@ struct StepReport {
   std::uint32_t coldRestarts = 0;
   double narrowPhaseSeconds = 0.0;
   double solverSeconds = 0.0;
+  /// Where the rest of the step's time went (wall seconds, summed over substeps): broad phase
+  /// (boxes, sweep and prune, pair bookkeeping and the budget's sort), constraint preparation
+  /// (persistent-contact matching, effective masses), integration with the bounds check.
+  double broadPhaseSeconds = 0.0;
+  double prepareSeconds = 0.0;
+  double integrateSeconds = 0.0;
+  /// Work the test budget does not count, summed over substeps: frontier pairs the queries
+  /// answered from (QueryResult::frontier), raw contacts before the manifold reduction
+  /// (QueryResult::rawContacts), and contacts in the velocity solve.
+  std::uint64_t frontierPairs = 0;
+  std::uint64_t rawContacts = 0;
+  std::uint64_t solverContacts = 0;
   std::vector<PairReport> pairs;     ///< pairs with contacts or queries this step, sorted (a, b)
   std::vector<BodyId> leftBounds;    ///< bodies that left WorldSettings::bounds in this step
   std::vector<Contact> contacts;     ///< last substep's contacts (world frame) ...

@@ -130,10 +130,12 @@ struct World::Impl {
     if (!(s.convergenceRel >= 0.0)) bad("convergenceRel must be >= 0");
     if (s.maxSubsteps == 0) bad("maxSubsteps must be >= 1");
     if (s.minSubsteps == 0 || s.minSubsteps > s.maxSubsteps) bad("minSubsteps must be in [1, maxSubsteps]");
+    if (s.sampledCellPairCost > 1024) bad("sampledCellPairCost must be in [0, 1024]");
   }
 
-  // limited == false: unlimited budget; else at most `allowance` tests this substep (0: none).
-  void substep(double h, bool limited, std::uint64_t allowance);
+  // limited == false: unlimited budget; else at most `allowance` budget units this substep (0:
+  // none); `nominal` = ceil(budget / substeps), a substep's even share of the step.
+  void substep(double h, bool limited, std::uint64_t allowance, std::uint64_t nominal);
   void solve(double h);
   void persistContacts(PairState& p, const Body& a, const Body& b, double diag);
   double kineticEnergyOfDynamicBodies() const;
@@ -195,8 +197,11 @@ void World::Impl::checkFinite() const {
   }
 }
 
-void World::Impl::substep(double h, bool limited, std::uint64_t allowance) {
+void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::uint64_t nominal) {
   const WorldSettings& s = settings;
+  using Clock = std::chrono::steady_clock;
+  auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+  const auto tBroad = Clock::now();
   // Gravity first (semi-implicit Euler: the solver then sees the velocity contacts must stop).
   for (Body& b : bodies)
     if (b.type == BodyType::kDynamic) b.v += s.gravity * h;
@@ -232,11 +237,18 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance) {
   });
   std::uint64_t remaining = allowance;
   std::size_t left = order.size();
+  // The contact tree samples every cell pair of its answer frontier; each costs `perCell` budget
+  // units (world.h). A query's frontier is at most max(F, T) pairs for a cached front of F pairs
+  // (F = 1 from the roots) and T tests: a retest keeps or drops a cached pair, and an expansion
+  // replaces one pair by at most as many children as it made tests (an interrupted expansion
+  // keeps the pair whole). So T is chosen with T + perCell * max(F, T) <= what the pair may spend.
+  const std::uint64_t perCell = s.model == ContactModel::kContactTree ? s.sampledCellPairCost : 0;
   QuerySettings qs;
   qs.model = s.model;
   qs.maxContacts = s.maxContacts;
   qs.maxLevel = s.maxLevel;
-  const auto t0 = std::chrono::steady_clock::now();
+  report.broadPhaseSeconds += since(tBroad);
+  const auto t0 = Clock::now();
   for (auto& [p, ids] : order) {
     Body& a = bodies[ids[0]];
     Body& bb = bodies[ids[1]];
@@ -252,14 +264,42 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance) {
         continue;
       }
       // share >= 1 and share <= remaining, so the substep never spends more than its allowance.
-      qs.budget = QueryBudget::tests(std::max<std::uint64_t>(1, remaining / left));
+      std::uint64_t share = std::max<std::uint64_t>(1, remaining / left);
+      if (perCell > 0) {
+        std::uint64_t front = std::max<std::uint64_t>(1, p->cache.frontSize());
+        if (perCell * front + 1 > nominal) {
+          // Its front alone costs more than a substep's even share of the step: it could wait for
+          // its turn forever, so it coarsens, from the roots.
+          p->cache.clear();
+          front = 1;
+        }
+        if (perCell * front + 1 > remaining) {
+          // Not affordable now: keep the contacts; ranked first next substep (stale).
+          pr.skipped = true;
+          ++report.pairsSkipped;
+          ++p->stale;
+          --left;
+          continue;
+        }
+        // A pair may go over its share to sample its front once (round robin evens it out), never
+        // over what the substep has left.
+        const std::uint64_t grant = std::max(share, perCell * front + 1);
+        const std::uint64_t withinFront = std::min(front, grant - perCell * front);  // T <= F
+        const std::uint64_t beyondFront = grant / (1 + perCell);                     // T > F
+        share = std::max(withinFront, beyondFront > front ? beyondFront : 0);
+      }
+      qs.budget = QueryBudget::tests(share);
     } else {
       qs.budget = QueryBudget::unlimited();
     }
     --left;
     queryContacts(*a.desc.shape, a.pose(), *bb.desc.shape, bb.pose(), qs, scratch, result, &p->cache);
-    remaining -= std::min(remaining, result.tests);
+    const std::uint64_t cost = result.tests + perCell * result.frontier.size();
+    remaining -= std::min(remaining, cost);
+    report.budgetSpent += cost;
     report.testsSpent += result.tests;
+    report.frontierPairs += result.frontier.size();
+    report.rawContacts += result.rawContacts;
     pr.tests += result.tests;
     pr.level = result.maxLevel;
     pr.finished = result.finished;
@@ -275,7 +315,8 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance) {
       p->contacts.push_back(cp);
     }
   }
-  report.narrowPhaseSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  report.narrowPhaseSeconds += since(t0);
+  const auto tPrepare = Clock::now();
 
   // The solver walks the pairs in a fixed order (by body ids), not in the budget's priority
   // order: Gauss-Seidel results depend on the order, and an order that changes from substep to
@@ -370,9 +411,13 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance) {
       cp.lambdaP = 0.0;
     }
     p->priority = approach + maxDepth / h;
+    report.solverContacts += p->contacts.size();
   }
+  report.prepareSeconds += since(tPrepare);
   solve(h);
+  const auto tIntegrate = Clock::now();
   integrate(h);
+  report.integrateSeconds += since(tIntegrate);
 }
 
 // Persistent contacts (as Bullet's persistent manifold and Box2D's contact ids do it): each new
@@ -637,9 +682,9 @@ const StepReport& World::step(double dt) {
   // does not spend rolls over to the next. The step never spends more than budgetTests.
   const bool limited = m.settings.budgetTests != 0;
   for (std::uint32_t i = 0; i < n; ++i) {
-    const std::uint64_t left = limited ? m.settings.budgetTests - std::min(m.settings.budgetTests, m.report.testsSpent) : 0;
+    const std::uint64_t left = limited ? m.settings.budgetTests - std::min(m.settings.budgetTests, m.report.budgetSpent) : 0;
     const std::uint64_t substepsLeft = n - i;
-    m.substep(h, limited, (left + substepsLeft - 1) / substepsLeft);
+    m.substep(h, limited, (left + substepsLeft - 1) / substepsLeft, (m.settings.budgetTests + n - 1) / n);
     m.checkFinite();
   }
   for (auto& [key, pr] : m.pairReports) {

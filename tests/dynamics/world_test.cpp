@@ -1,5 +1,6 @@
 // Physics tests of the world against analytic facts: conservation laws, rest, stacking,
 // tunnelling. Every tolerance is justified where it is used.
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -295,6 +296,51 @@ TEST(World, BudgetBoundsTheTestsOfEveryFrame) {
     EXPECT_LE(r.testsSpent, r.testsBudget) << "step " << i;
     interrupted += r.pairsInterrupted + r.pairsSkipped;
   }
+  EXPECT_GT(interrupted, 0u) << "the budget never bit: the test would prove nothing";
+}
+
+// The contact tree samples every frontier cell pair of its answer, tested this query or kept from
+// the pair's cache; the world charges WorldSettings::sampledCellPairCost per sampled pair, so the
+// frame's sampling work is bounded by the budget too. Oracle: with the charge off (0) the same
+// scene samples more cell pairs per frame than the budget, so the bound is not there by accident.
+TEST(World, ContactTreeBudgetCountsSampledCellPairs) {
+  const auto slab = bakeShape(makeBox(Vec3(3.0, 3.0, 0.25)));
+  // Eight cubes 1.1 m apart (0.1 m gaps) dropped from 0.05-0.4 m onto the slab.
+  auto run = [&](std::uint32_t cost, std::uint64_t& maxSampled, std::uint64_t& interrupted) {
+    WorldSettings ws;
+    ws.model = ContactModel::kContactTree;
+    ws.budgetTests = 40;
+    ws.sampledCellPairCost = cost;
+    World world(ws);
+    RigidBodyDesc ground;
+    ground.shape = slab;
+    ground.type = BodyType::kStatic;
+    world.addBody(ground);
+    for (int i = 0; i < 8; ++i) {
+      RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
+      box.position = Vec3(-1.65 + 1.1 * (i % 4), i < 4 ? -0.55 : 0.55, 0.8 + 0.05 * i);
+      world.addBody(box);
+    }
+    maxSampled = interrupted = 0;
+    for (int i = 0; i < 90; ++i) {
+      const StepReport& r = world.step(1.0 / 60.0);
+      EXPECT_EQ(r.budgetSpent, r.testsSpent + std::uint64_t(cost) * r.frontierPairs) << "step " << i;
+      EXPECT_LE(r.testsSpent, r.testsBudget) << "step " << i;
+      if (cost > 0) {
+        EXPECT_LE(r.budgetSpent, r.testsBudget) << "step " << i;
+      }
+      maxSampled = std::max(maxSampled, r.frontierPairs);
+      interrupted += r.pairsInterrupted + r.pairsSkipped;
+    }
+    // Every box ends on the slab (top at z = 0.25, box centre at 0.75): charging the sampling
+    // must not let a box through. 5 cm = 5 % of the box, far above the resting penetration.
+    for (BodyId b = 1; b < world.bodyCount(); ++b) EXPECT_GT(world.state(b).position.z(), 0.7) << "cost " << cost << " body " << b;
+  };
+  std::uint64_t maxSampled = 0, interrupted = 0;
+  run(0, maxSampled, interrupted);
+  EXPECT_GT(maxSampled, 40u) << "without the charge the sampling never exceeded the budget: the test would prove nothing";
+  run(2, maxSampled, interrupted);
+  EXPECT_LE(2 * maxSampled, 40u);
   EXPECT_GT(interrupted, 0u) << "the budget never bit: the test would prove nothing";
 }
 
