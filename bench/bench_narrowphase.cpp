@@ -23,6 +23,9 @@
 // depth error = |deepest contact's depth - the exact depth|; point error = distance between the
 // manifolds' centroids; lengths in units of the diagonal (1). Times are this thread's CPU time of
 // the one call. Prints a markdown table of medians and 95th percentiles.
+// --accuracy-models=cfm,exact and --accuracy-meshes=bunny,fandisk restrict the rows (names
+// as printed, comma-separated; FCL and Bullet are the models "fcl" and "bullet"); the poses stay the
+// same (same seeds), so restricted runs compare row by row with full ones.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -321,7 +324,14 @@ double percentile(std::vector<double> v, double q) {
   return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5))];
 }
 
-void runAccuracy(int poses, const char* dataPath) {
+// Row filter of the accuracy harness: empty = all; else a comma-separated list of names.
+bool selected(const char* list, const std::string& name) {
+  if (list == nullptr || *list == 0) return true;
+  const std::string l = std::string(",") + list + ",";
+  return l.find("," + name + ",") != std::string::npos;
+}
+
+void runAccuracy(int poses, const char* dataPath, const char* models, const char* meshes) {
   std::FILE* data = dataPath != nullptr ? std::fopen(dataPath, "w") : nullptr;
   if (data != nullptr) {
     std::fprintf(data, "# budget 0 = unlimited; FCL/Bullet rows have budget -\n# mesh method budget time_us_median normal_deg_median normal_deg_p95 depth_err_median point_err_median\n");
@@ -329,6 +339,7 @@ void runAccuracy(int poses, const char* dataPath) {
   std::printf("| mesh | method | budget | median CPU time (us) | normal error median (deg) | p95 (deg) | depth error median (diag) | p95 (diag) | point error median (diag) | p95 (diag) | no contact |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (int mesh = 0; mesh < 3; ++mesh) {
+    if (!selected(meshes, kMeshNames[mesh])) continue;
     const CollisionBody& a = *body(mesh).body;
     std::mt19937_64 rng(1234 + mesh);
     std::normal_distribution<double> gauss;
@@ -362,6 +373,10 @@ void runAccuracy(int poses, const char* dataPath) {
       int m = 0;
       for (ContactModel model : allContactModels()) {
         for (std::uint64_t budget : kBudgets) {
+          if (!selected(models, std::string(contactModelName(model)))) {
+            ++m;
+            continue;
+          }
           s.model = model;
           s.budget.maxTests = budget;
           const double t0 = threadSeconds();
@@ -372,7 +387,7 @@ void runAccuracy(int poses, const char* dataPath) {
         }
       }
 #if defined(CLOD_BENCH_HAVE_FCL)
-      {
+      if (selected(models, "fcl")) {
         fcl::CollisionResultd fr;
         const double t0 = threadSeconds();
         const std::size_t n = fclCollide(mesh, pb, fr);
@@ -392,7 +407,7 @@ void runAccuracy(int poses, const char* dataPath) {
       }
 #endif
 #if defined(CLOD_BENCH_HAVE_BULLET)
-      {
+      if (selected(models, "bullet")) {
         BulletScene scene(mesh, pb);
         Vec3 normal = Vec3::Zero(), c = Vec3::Zero();
         double depth = 0.0;
@@ -433,13 +448,17 @@ void runAccuracy(int poses, const char* dataPath) {
 
 int main(int argc, char** argv) {
   const char* dataPath = nullptr;
+  const char* models = nullptr;
+  const char* meshes = nullptr;
   for (int i = 1; i < argc; ++i) {
     if (std::strncmp(argv[i], "--accuracy-data=", 16) == 0) dataPath = argv[i] + 16;
+    if (std::strncmp(argv[i], "--accuracy-models=", 18) == 0) models = argv[i] + 18;
+    if (std::strncmp(argv[i], "--accuracy-meshes=", 18) == 0) meshes = argv[i] + 18;
   }
   for (int i = 1; i < argc; ++i) {
-    if (std::strncmp(argv[i], "--accuracy", 10) == 0 && std::strncmp(argv[i], "--accuracy-data", 15) != 0) {
+    if (std::strncmp(argv[i], "--accuracy", 10) == 0 && (argv[i][10] == '=' || argv[i][10] == 0)) {
       const int poses = argv[i][10] == '=' ? std::atoi(argv[i] + 11) : 2000;
-      runAccuracy(std::max(1, poses), dataPath);
+      runAccuracy(std::max(1, poses), dataPath, models, meshes);
       return 0;
     }
   }

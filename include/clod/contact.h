@@ -73,6 +73,15 @@ struct ManifoldSettings {
   /// Contacts closer than this (length units, >= 0) to an already kept one are merged into it
   /// (dropped), so a face-on-face contact does not return many copies of one corner.
   double mergeDistanceAbs = 0.0;
+  /// Normal pooling (off when > 1): every contact not kept is assigned to the nearest kept one
+  /// (distance in the contact plane, as for the selection) whose normal is within this cosine of
+  /// its own, and each kept contact's normal becomes the depth-weighted mean of its own and its
+  /// assigned contacts' normals (weights max(depth, 0); equal weights where all are 0). A kept
+  /// contact then pushes along the total penalty force of the contacts it stands for, not along
+  /// its own noisy normal. Contacts whose normals differ by more (a wall next to a floor) are not
+  /// pooled together. The cfm model (and an interrupted exact query) uses cos 60 deg
+  /// (query.cpp, docs/narrow-phase.md).
+  double poolNormalsCos = 2.0;
 };
 
 /// Reduces `contacts` to a manifold of at most settings.maxContacts well-spread contacts, in
@@ -81,7 +90,8 @@ struct ManifoldSettings {
 /// distance to the kept ones, measured in the plane perpendicular to the deepest contact's
 /// normal (farthest-point sampling in the contact plane), is largest; stop at maxContacts or
 /// when that distance falls to mergeDistanceAbs or below. Ties are broken by input order, so
-/// the result depends only on the input sequence. `scratch` is reused (no allocation once it
+/// the result depends only on the input sequence. Then, if poolNormalsCos <= 1, the kept
+/// contacts' normals are pooled (ManifoldSettings::poolNormalsCos). `scratch` is reused (no allocation once it
 /// has grown to contacts.size()). O(n * maxContacts). Throws clod::Error(kInvalidArgument) if
 /// maxContacts == 0 or mergeDistanceAbs is negative or not finite.
 std::size_t reduceManifold(std::span<Contact> contacts, const ManifoldSettings& settings,

@@ -1,5 +1,6 @@
 #include "clod/contact.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -74,6 +75,48 @@ std::size_t reduceManifold(std::span<Contact> contacts, const ManifoldSettings& 
       scratch[i] = std::min(scratch[i], planar(contacts[i].point - contacts[kept].point));
     }
     ++kept;
+  }
+  if (settings.poolNormalsCos <= 1.0 && kept < n) {
+    // scratch[kept .. n) are free (distances of the not-kept contacts are recomputed per kept
+    // contact below); the sums go after them: 4 doubles per kept contact (x, y, z, weight).
+    scratch.resize(n + 4 * kept);
+    double* sums = scratch.data() + n;
+    for (std::size_t k = 0; k < kept; ++k) {
+      const double w = std::max(contacts[k].depth, 0.0);
+      sums[4 * k + 0] = w * contacts[k].normal.x();
+      sums[4 * k + 1] = w * contacts[k].normal.y();
+      sums[4 * k + 2] = w * contacts[k].normal.z();
+      sums[4 * k + 3] = w;
+    }
+    bool anyWeight = false;
+    for (std::size_t k = 0; k < kept; ++k) anyWeight = anyWeight || sums[4 * k + 3] > 0.0;
+    for (std::size_t i = kept; i < n; ++i) {
+      std::size_t nearest = kept;
+      double nearestDistance = std::numeric_limits<double>::infinity();
+      for (std::size_t k = 0; k < kept; ++k) {
+        if (contacts[i].normal.dot(contacts[k].normal) < settings.poolNormalsCos) continue;
+        const double d = planar(contacts[i].point - contacts[k].point);
+        if (d < nearestDistance) {
+          nearestDistance = d;
+          nearest = k;
+        }
+      }
+      if (nearest == kept) continue;
+      const double w = std::max(contacts[i].depth, 0.0);
+      anyWeight = anyWeight || w > 0.0;
+      sums[4 * nearest + 0] += w * contacts[i].normal.x();
+      sums[4 * nearest + 1] += w * contacts[i].normal.y();
+      sums[4 * nearest + 2] += w * contacts[i].normal.z();
+      sums[4 * nearest + 3] += w;
+    }
+    if (anyWeight) {
+      for (std::size_t k = 0; k < kept; ++k) {
+        const Vec3 sum(sums[4 * k + 0], sums[4 * k + 1], sums[4 * k + 2]);
+        const double length = sum.norm();
+        // A kept contact of depth <= 0 with only such contacts assigned keeps its own normal.
+        if (sums[4 * k + 3] > 0.0 && length > 1e-12 * sums[4 * k + 3]) contacts[k].normal = sum / length;
+      }
+    }
   }
   return kept;
 }

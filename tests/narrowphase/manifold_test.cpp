@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 #include "clod/contact.h"
@@ -56,6 +57,36 @@ TEST(ReduceManifold, RejectsBadSettings) {
   EXPECT_THROW(reduceManifold(contacts, {0, 0.0}, scratch), Error);
   EXPECT_THROW(reduceManifold(contacts, {4, -1.0}, scratch), Error);
   EXPECT_EQ(reduceManifold(std::span<Contact>(), {4, 0.0}, scratch), 0u);
+}
+
+TEST(ReduceManifold, PoolsNormalsOfTheContactsAKeptContactStandsForWithinTheCone) {
+  // Two kept contacts: the deepest at the origin and the farthest at (1, 0). Not kept: one at
+  // (0.05, 0) tilted 20 deg about x (pooled into the first: the depth-weighted mean of the two
+  // normals, an analytic answer), and one at (0.95, 0) tilted 80 deg (a wall next to the floor:
+  // outside the 60 deg cone of both kept contacts, so it changes nothing).
+  constexpr double kDeg = 3.14159265358979323846 / 180.0;
+  const Vec3 tilted20(0.0, -std::sin(20.0 * kDeg), std::cos(20.0 * kDeg));
+  const Vec3 tilted80(0.0, -std::sin(80.0 * kDeg), std::cos(80.0 * kDeg));
+  std::vector<Contact> contacts = {at(0.0, 0.0, 0.2), at(1.0, 0.0, 0.1), at(0.05, 0.0, 0.1), at(0.95, 0.0, 0.05)};
+  contacts[2].normal = tilted20;
+  contacts[3].normal = tilted80;
+  std::vector<double> scratch;
+  ManifoldSettings settings;
+  settings.maxContacts = 2;
+  settings.poolNormalsCos = 0.5;  // 60 deg
+  ASSERT_EQ(reduceManifold(contacts, settings, scratch), 2u);
+  EXPECT_EQ(contacts[0].point, Vec3(0.0, 0.0, 0.0));
+  EXPECT_EQ(contacts[1].point, Vec3(1.0, 0.0, 0.0));
+  const Vec3 expected = (0.2 * Vec3::UnitZ() + 0.1 * tilted20).normalized();
+  EXPECT_LT((contacts[0].normal - expected).norm(), 1e-12);  // rounding only
+  EXPECT_EQ(contacts[1].normal, Vec3::UnitZ());
+  EXPECT_EQ(contacts[0].depth, 0.2);  // depths and points are not pooled
+  // Off (the default): the kept normals are the contacts' own.
+  contacts = {at(0.0, 0.0, 0.2), at(1.0, 0.0, 0.1), at(0.05, 0.0, 0.1), at(0.95, 0.0, 0.05)};
+  contacts[2].normal = tilted20;
+  settings.poolNormalsCos = 2.0;
+  ASSERT_EQ(reduceManifold(contacts, settings, scratch), 2u);
+  EXPECT_EQ(contacts[0].normal, Vec3::UnitZ());
 }
 
 }  // namespace
