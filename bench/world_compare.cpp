@@ -10,7 +10,11 @@
 //   world_compare [--scene FILE] [--cache DIR] [--steps N] [--models dos,cfm,contact-tree,exact]
 //                 [--budgets 1024,4096,16384,0] [--bullet gimpact,hull|none]
 //                 [--bullet-substeps 1,clod] [--bullet-steps N] [--bullet-iterations N]
-//                 [--row-seconds S] [--breakdown 1]
+//                 [--row-seconds S] [--breakdown 1] [--frames-csv FILE] [--frontier-cost N]
+//                 [--min-substep-iterations N]
+// --frontier-cost N and --min-substep-iterations N override WorldSettings::frontierPairCost and
+// ::minSubstepIterations (defaults: the library's) for experiments.
+// --frames-csv FILE writes every clod frame's breakdown figures (the columns of --breakdown) as CSV.
 // --breakdown 1 adds, after the table, per clod row the breakdown of the frames at the CPU median,
 // at the CPU 99th percentile and of the slowest frame: substeps, pairs, tests, the work the budget
 // does not count (frontier pairs sampled / turned into contacts, raw contacts, solver contacts)
@@ -82,6 +86,8 @@ struct Options {
   int bulletIterations = 20;
   double rowSeconds = 180.0;  // a row stops after this much wall time (0 = never)
   bool breakdown = false;
+  std::string framesCsv;
+  std::optional<std::uint32_t> frontierCost, minSubstepIterations;
 };
 
 struct UsageError {
@@ -117,6 +123,9 @@ Options parseOptions(int argc, char** argv) {
     else if (flag == "--steps") o.steps = std::uint32_t(parseCount(flag, value));
     else if (flag == "--bullet-steps") o.bulletSteps = std::uint32_t(parseCount(flag, value));
     else if (flag == "--breakdown") o.breakdown = parseCount(flag, value) != 0;
+    else if (flag == "--frames-csv") o.framesCsv = value;
+    else if (flag == "--frontier-cost") o.frontierCost = std::uint32_t(parseCount(flag, value));
+    else if (flag == "--min-substep-iterations") o.minSubstepIterations = std::uint32_t(parseCount(flag, value));
     else if (flag == "--row-seconds") {
       char* end = nullptr;
       o.rowSeconds = std::strtod(value.c_str(), &end);
@@ -261,8 +270,10 @@ void progress(const std::string& label, std::uint32_t step, std::uint32_t steps)
 // each budget row then starts from a fresh World with the template's bodies (descs hold the
 // initial state and share the baked shapes), so the contact trees are built once per run.
 Row runClod(const clod::World& tmpl, const clod::SceneDescription& scene, clod::ContactModel model,
-            std::uint64_t budget, std::uint32_t steps, double rowSeconds, const Bin& bin) {
+            std::uint64_t budget, std::uint32_t steps, double rowSeconds, const Bin& bin, const Options& o) {
   clod::WorldSettings ws = scene.world;
+  if (o.frontierCost) ws.frontierPairCost = *o.frontierCost;
+  if (o.minSubstepIterations) ws.minSubstepIterations = *o.minSubstepIterations;
   ws.model = model;
   ws.budgetTests = budget;
   clod::World world(ws);
@@ -574,7 +585,7 @@ int run(const Options& o) {
               << fmt(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1) << " s ("
               << rep.shapesBaked << " shapes baked, " << rep.shapesFromCache << " from cache)\n";
     for (std::uint64_t budget : o.budgets) {
-      rows.push_back(runClod(tmpl, s, s.world.model, budget, steps, o.rowSeconds, bin));
+      rows.push_back(runClod(tmpl, s, s.world.model, budget, steps, o.rowSeconds, bin, o));
       printTable({rows.back()});
     }
     if (!any) any.emplace(std::move(tmpl));
@@ -603,6 +614,21 @@ int run(const Options& o) {
   std::cout << "\nAll rows:\n\n";
   printTable(rows);
   if (o.breakdown) printBreakdown(rows);
+  if (!o.framesCsv.empty()) {
+    std::FILE* f = std::fopen(o.framesCsv.c_str(), "w");
+    if (!f) throw clod::Error(clod::ErrorCode::kFileWriteFailed, "cannot write " + o.framesCsv);
+    std::fprintf(f, "model,budget,frame,cpu_ms,substeps,candidate_pairs,tests,budget_spent,pairs_skipped,frontier_pairs,"
+                    "raw_contacts,solver_contacts,solver_iterations,broad_ms,narrow_ms,prepare_ms,solver_ms,integrate_ms\n");
+    for (const Row& r : rows)
+      for (const Frame& x : r.frames)
+        std::fprintf(f, "%s,%s,%u,%.4f,%u,%llu,%llu,%llu,%llu,%llu,%llu,%llu,%u,%.4f,%.4f,%.4f,%.4f,%.4f\n", r.model.c_str(),
+                     r.budget.c_str(), x.step, 1e3 * x.cpu, x.substeps, (unsigned long long)x.candidatePairs,
+                     (unsigned long long)x.tests, (unsigned long long)x.spent, (unsigned long long)x.skipped,
+                     (unsigned long long)x.frontierPairs, (unsigned long long)x.rawContacts,
+                     (unsigned long long)x.solverContacts, x.iterations, 1e3 * x.broad, 1e3 * x.narrow, 1e3 * x.prepare,
+                     1e3 * x.solver, 1e3 * x.integrate);
+    std::fclose(f);
+  }
   return 0;
 }
 
@@ -616,7 +642,8 @@ int main(int argc, char** argv) {
     std::cerr << "usage: world_compare [--scene FILE] [--cache DIR] [--steps N] [--models dos,cfm,contact-tree,exact|none]\n"
                  "                     [--budgets 1024,4096,16384,unlimited] [--bullet gimpact,hull|none]\n"
                  "                     [--bullet-substeps 1,clod] [--bullet-steps N] [--bullet-iterations N]\n"
-                 "                     [--row-seconds S] [--breakdown 1]\n";
+                 "                     [--row-seconds S] [--breakdown 1] [--frames-csv FILE] [--frontier-cost N]\n"
+                 "                     [--min-substep-iterations N]\n";
     return e.message.empty() ? 0 : 2;
   } catch (const clod::Error& e) {
     std::cerr << "world_compare: " << e.what() << '\n';

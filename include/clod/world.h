@@ -31,12 +31,14 @@
 // pairs after it. When the budget is gone, the remaining pairs are not queried: they keep their
 // last contacts (graceful fallback) and are reported as skipped. Each pair keeps a
 // CoherenceCache, so an interrupted pair resumes from the level it reached next time. Hence a
-// step makes at most budgetTests tests. The contact tree also samples every frontier cell pair
-// of its answer, tested or not; that work is charged too (WorldSettings::sampledCellPairCost per
-// cell pair), and a query is given only as many tests as keep its frontier -- at most
-// max(cached front, tests) pairs -- within what it may spend: a pair whose cached front costs
-// more than the substep has left waits for the next substep (it is then ranked first), and one
-// whose front costs more than a whole substep's share restarts from the roots.
+// step makes at most budgetTests tests. The contact tree, cfm and exact also do work per pair of
+// the answer frontier, tested or not (sampling, map lookups); that is charged too
+// (WorldSettings::frontierPairCost per frontier pair), and a query is given only as many tests as
+// keep its frontier -- at most max(cached front, tests) pairs -- within what it may spend: a pair
+// whose cached front costs more than the substep has left waits for the next substep (it is then
+// ranked first), and one whose front costs more than a substep's even share restarts from the
+// roots. dos pairs with an immovable body get at least their front + 8 tests (or wait), so they
+// can get below the root spheres (docs/dynamics.md, the bin).
 //
 // Energy: the velocity solve is checked -- if the warm-started solve ends with more kinetic energy
 // than it started with, it is redone from zero impulses -- and the restitution impulses are scaled
@@ -69,17 +71,21 @@ struct WorldSettings {
   /// substeps together; 0 = unlimited. A step never spends more. Each substep gets an equal
   /// share of what the step has left (rounded up); what it does not spend rolls over.
   std::uint64_t budgetTests = 0;
-  /// Budget units charged per frontier cell pair a contact-tree query samples (0..1024). The
-  /// contact tree turns every cell pair of its answer frontier into contacts by sampling, tested
-  /// this query or kept from the pair's CoherenceCache, so without this charge its frame cost
-  /// grows with the frontier and the substep count, not with the budget (docs/dynamics.md,
-  /// "Collision budget per frame", has the measurement). The budget then counts tests +
-  /// sampledCellPairCost x sampled cell pairs (StepReport::budgetSpent). 0 = only tests count
-  /// (the behaviour before). Other models ignore it.
-  std::uint32_t sampledCellPairCost = 1;
+  /// Budget units charged per pair of the answer frontier a query turns into contacts (0..1024),
+  /// for the models that do real work per frontier pair besides the tests: the contact tree
+  /// samples each cell pair, cfm looks up both closest feature maps and runs a separating-axis
+  /// test per sphere pair, exact does that for the pairs an interrupted query did not
+  /// triangle-test. Tested this query or kept from the pair's CoherenceCache, every frontier pair
+  /// is answered, so without this charge the frame cost grows with the frontier and the substep
+  /// count, not with the budget (docs/dynamics.md, "Collision budget per frame", has the
+  /// measurement). The budget then counts tests + frontierPairCost x frontier pairs
+  /// (StepReport::budgetSpent). 0 = only tests count (the behaviour before). dos and average
+  /// (a D&O point per pair: a few flops) are not charged.
+  std::uint32_t frontierPairCost = 2;
   /// Manifold size per pair (QuerySettings::maxContacts), >= 1.
   std::uint32_t maxContacts = 8;
-  /// Velocity iterations of the sequential-impulse solver (>= 1); position iterations likewise.
+  /// Velocity iterations of the sequential-impulse solver per substep (>= 1; see
+  /// minSubstepIterations for steps with extra substeps); position iterations likewise.
   std::uint32_t velocityIterations = 20;
   std::uint32_t positionIterations = 4;
   /// Stop iterating early when no impulse changed by more than this (relative to the largest
@@ -96,6 +102,14 @@ struct WorldSettings {
   std::uint32_t maxLevel = UINT32_MAX;
   /// At most this many substeps per step (>= 1).
   std::uint32_t maxSubsteps = 128;
+  /// Velocity iterations per substep when a step needs more than minSubsteps substeps (fast
+  /// bodies): the step's velocityIterations x minSubsteps iterations are spread over its n
+  /// substeps, ceil(velocityIterations x minSubsteps / n) each but at least this many (and at
+  /// most velocityIterations). Smaller steps converge better than more iterations at equal cost
+  /// (Macklin et al., SCA 2019, see minSubsteps), and it keeps a fast-moving frame's solver cost
+  /// near a resting frame's instead of n times it (docs/dynamics.md). 0 = velocityIterations in
+  /// every substep (the behaviour before).
+  std::uint32_t minSubstepIterations = 4;
   /// At least this many substeps per step, in [1, maxSubsteps]. Tall stacks need it: projected
   /// Gauss-Seidel passes support down a stack of n bodies only about one body per iteration, and
   /// smaller steps converge far better than more iterations at equal cost (Macklin et al., "Small
@@ -124,8 +138,8 @@ struct StepReport {
   std::uint64_t candidatePairs = 0;  ///< broad-phase pairs, summed over substeps
   std::uint64_t testsSpent = 0;      ///< narrow-phase tests, all pairs and substeps
   std::uint64_t testsBudget = 0;     ///< WorldSettings::budgetTests (0 = unlimited); testsSpent <= it
-  /// What the budget counted: testsSpent + WorldSettings::sampledCellPairCost x the cell pairs the
-  /// contact-tree queries sampled (= testsSpent for the other models); <= testsBudget when limited.
+  /// What the budget counted: testsSpent + WorldSettings::frontierPairCost x the frontier pairs of
+  /// the charged models' queries (= testsSpent for dos and average); <= testsBudget when limited.
   std::uint64_t budgetSpent = 0;
   std::uint64_t pairsSkipped = 0;    ///< pair queries skipped for lack of budget, summed
   std::uint64_t pairsInterrupted = 0;///< queries that stopped before the leaves, summed

@@ -117,6 +117,7 @@ struct World::Impl {
   std::vector<std::pair<PairState*, std::array<BodyId, 2>>> solveOrder;
   std::vector<Vec3> savedV, savedW, dV, dW;
   std::map<std::uint64_t, PairReport> pairReports;
+  std::uint32_t velocityIterationsNow = 20;
 
   void validateSettings() const {
     const WorldSettings& s = settings;
@@ -130,7 +131,7 @@ struct World::Impl {
     if (!(s.convergenceRel >= 0.0)) bad("convergenceRel must be >= 0");
     if (s.maxSubsteps == 0) bad("maxSubsteps must be >= 1");
     if (s.minSubsteps == 0 || s.minSubsteps > s.maxSubsteps) bad("minSubsteps must be in [1, maxSubsteps]");
-    if (s.sampledCellPairCost > 1024) bad("sampledCellPairCost must be in [0, 1024]");
+    if (s.frontierPairCost > 1024) bad("frontierPairCost must be in [0, 1024]");
   }
 
   // limited == false: unlimited budget; else at most `allowance` budget units this substep (0:
@@ -237,12 +238,16 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
   });
   std::uint64_t remaining = allowance;
   std::size_t left = order.size();
-  // The contact tree samples every cell pair of its answer frontier; each costs `perCell` budget
-  // units (world.h). A query's frontier is at most max(F, T) pairs for a cached front of F pairs
-  // (F = 1 from the roots) and T tests: a retest keeps or drops a cached pair, and an expansion
-  // replaces one pair by at most as many children as it made tests (an interrupted expansion
-  // keeps the pair whole). So T is chosen with T + perCell * max(F, T) <= what the pair may spend.
-  const std::uint64_t perCell = s.model == ContactModel::kContactTree ? s.sampledCellPairCost : 0;
+  // The contact tree samples every cell pair of its answer frontier, cfm looks up both maps and
+  // runs a separating-axis test per frontier sphere pair, and exact does the latter for the pairs
+  // an interrupted query did not triangle-test: each frontier pair costs `perCell` budget units
+  // (world.h). A query's frontier is at most max(F, T) pairs for a cached front of F pairs (F = 1
+  // from the roots) and T tests: a retest keeps or drops a cached pair, and an expansion replaces
+  // one pair by at most as many children as it made tests (an interrupted expansion keeps the
+  // pair whole). So T is chosen with T + perCell * max(F, T) <= what the pair may spend.
+  const bool chargedFrontier =
+      s.model == ContactModel::kContactTree || s.model == ContactModel::kCfm || s.model == ContactModel::kExact;
+  const std::uint64_t perCell = chargedFrontier ? s.frontierPairCost : 0;
   QuerySettings qs;
   qs.model = s.model;
   qs.maxContacts = s.maxContacts;
@@ -256,11 +261,15 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     pr.a = ids[0];
     pr.b = ids[1];
     if (limited) {
-      if (remaining == 0) {
+      // A skipped pair keeps its contacts and is ranked first next substep (stale).
+      auto skip = [&] {
         pr.skipped = true;
         ++report.pairsSkipped;
         ++p->stale;
         --left;
+      };
+      if (remaining == 0) {
+        skip();
         continue;
       }
       // share >= 1 and share <= remaining, so the substep never spends more than its allowance.
@@ -273,12 +282,8 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
           p->cache.clear();
           front = 1;
         }
-        if (perCell * front + 1 > remaining) {
-          // Not affordable now: keep the contacts; ranked first next substep (stale).
-          pr.skipped = true;
-          ++report.pairsSkipped;
-          ++p->stale;
-          --left;
+        if (perCell * front + 1 > remaining) {  // not affordable now
+          skip();
           continue;
         }
         // A pair may go over its share to sample its front once (round robin evens it out), never
@@ -287,6 +292,24 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
         const std::uint64_t withinFront = std::min(front, grant - perCell * front);  // T <= F
         const std::uint64_t beyondFront = grant / (1 + perCell);                     // T > F
         share = std::max(withinFront, beyondFront > front ? beyondFront : 0);
+      } else if (s.model == ContactModel::kDos && (a.invMass == 0.0) != (bb.invMass == 0.0)) {
+        // D&O contacts carry no surface: a pair's answer at its root spheres is the centre line,
+        // which for a body near the edge of a large static floor is nearly horizontal and lets
+        // the body slide through (docs/dynamics.md, the bin). Such a pair gets at least enough
+        // tests to retest its front and expand one pair (8 children per sphere at most with the
+        // default SphereTreeSettings::branching; an interrupted expansion is dropped, so with
+        // fewer tests a root front never gets below the roots), or waits for its turn. The other
+        // models' coarse contacts carry a surface normal (cfm's maps, exact's cfm fallback, the
+        // contact tree's half-spaces); for them the same rule measured worse (more bodies lost at
+        // 1,024 tests per frame).
+        const std::uint64_t useful = std::min<std::uint64_t>(std::max<std::uint64_t>(1, p->cache.frontSize()) + 8, nominal);
+        if (share < useful) {
+          if (useful > remaining) {
+            skip();
+            continue;
+          }
+          share = useful;
+        }
       }
       qs.budget = QueryBudget::tests(share);
     } else {
@@ -500,7 +523,7 @@ void World::Impl::solve(double h) {
         for (SolverContact& cp : p->contacts)
           apply(bodies[ids[0]], bodies[ids[1]], cp, cp.lambdaN * cp.c.normal + cp.lambdaT1 * cp.t1 + cp.lambdaT2 * cp.t2);
     std::uint32_t used = 0;
-    for (std::uint32_t it = 0; it < s.velocityIterations; ++it) {
+    for (std::uint32_t it = 0; it < velocityIterationsNow; ++it) {
       ++used;
       double maxChange = 0.0, maxLambda = 0.0;
       for (auto& [p, ids] : solveOrder) {
@@ -675,6 +698,14 @@ const StepReport& World::step(double dt) {
     n = std::isfinite(want) ? std::uint32_t(std::clamp(want, double(n), double(m.settings.maxSubsteps))) : m.settings.maxSubsteps;
   }
   m.report.substeps = n;
+  m.velocityIterationsNow = m.settings.velocityIterations;
+  if (m.settings.minSubstepIterations > 0) {
+    // velocityIterations per substep at minSubsteps substeps; a step that needs more substeps
+    // (fast bodies) spreads the same iterations over them, at least minSubstepIterations each.
+    const std::uint64_t perStep = std::uint64_t(m.settings.velocityIterations) * m.settings.minSubsteps;
+    m.velocityIterationsNow = std::uint32_t(std::min<std::uint64_t>(
+        m.settings.velocityIterations, std::max<std::uint64_t>(m.settings.minSubstepIterations, (perStep + n - 1) / n)));
+  }
   m.report.testsBudget = m.settings.budgetTests;
   const double h = dt / n;
   // The budget is per step: each substep may spend an equal share of what the step has left,

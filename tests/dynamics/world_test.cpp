@@ -300,17 +300,19 @@ TEST(World, BudgetBoundsTheTestsOfEveryFrame) {
 }
 
 // The contact tree samples every frontier cell pair of its answer, tested this query or kept from
-// the pair's cache; the world charges WorldSettings::sampledCellPairCost per sampled pair, so the
-// frame's sampling work is bounded by the budget too. Oracle: with the charge off (0) the same
-// scene samples more cell pairs per frame than the budget, so the bound is not there by accident.
-TEST(World, ContactTreeBudgetCountsSampledCellPairs) {
+// the pair's cache (cfm: map lookups and a separating-axis test per frontier sphere pair); the
+// world charges WorldSettings::frontierPairCost per frontier pair, so that work is bounded by the
+// budget too. Oracle: with the charge off (0) the same scene answers from more frontier pairs
+// per frame than the budget, so the bound is not there by accident.
+TEST(World, BudgetCountsFrontierPairs) {
   const auto slab = bakeShape(makeBox(Vec3(3.0, 3.0, 0.25)));
   // Eight cubes 1.1 m apart (0.1 m gaps) dropped from 0.05-0.4 m onto the slab.
+  ContactModel model = ContactModel::kContactTree;
   auto run = [&](std::uint32_t cost, std::uint64_t& maxSampled, std::uint64_t& interrupted) {
     WorldSettings ws;
-    ws.model = ContactModel::kContactTree;
+    ws.model = model;
     ws.budgetTests = 40;
-    ws.sampledCellPairCost = cost;
+    ws.frontierPairCost = cost;
     World world(ws);
     RigidBodyDesc ground;
     ground.shape = slab;
@@ -334,14 +336,55 @@ TEST(World, ContactTreeBudgetCountsSampledCellPairs) {
     }
     // Every box ends on the slab (top at z = 0.25, box centre at 0.75): charging the sampling
     // must not let a box through. 5 cm = 5 % of the box, far above the resting penetration.
-    for (BodyId b = 1; b < world.bodyCount(); ++b) EXPECT_GT(world.state(b).position.z(), 0.7) << "cost " << cost << " body " << b;
+    for (BodyId b = 1; b < world.bodyCount(); ++b)
+      EXPECT_GT(world.state(b).position.z(), 0.7) << contactModelName(model) << " cost " << cost << " body " << b;
   };
-  std::uint64_t maxSampled = 0, interrupted = 0;
-  run(0, maxSampled, interrupted);
-  EXPECT_GT(maxSampled, 40u) << "without the charge the sampling never exceeded the budget: the test would prove nothing";
-  run(2, maxSampled, interrupted);
-  EXPECT_LE(2 * maxSampled, 40u);
-  EXPECT_GT(interrupted, 0u) << "the budget never bit: the test would prove nothing";
+  for (ContactModel m : {ContactModel::kContactTree, ContactModel::kCfm}) {
+    model = m;
+    std::uint64_t maxSampled = 0, interrupted = 0;
+    run(0, maxSampled, interrupted);
+    EXPECT_GT(maxSampled, 40u) << contactModelName(m) << ": without the charge the frontier never exceeded the budget";
+    run(2, maxSampled, interrupted);
+    EXPECT_LE(2 * maxSampled, 40u) << contactModelName(m);
+    EXPECT_GT(interrupted, 0u) << contactModelName(m) << ": the budget never bit: the test would prove nothing";
+  }
+}
+
+// A step that needs more substeps than minSubsteps (a fast body) spreads the step's
+// velocityIterations x minSubsteps over them, at least minSubstepIterations each
+// (WorldSettings::minSubstepIterations). Oracle: the arithmetic of that rule, per step, on a box
+// thrown down onto a slab at 20 m/s (about 3 substeps per 1/60 s step while it is fast); a
+// cold restart runs a substep's iterations twice.
+TEST(World, ExtraSubstepsShareTheStepsVelocityIterations) {
+  const auto slab = bakeShape(makeBox(Vec3(2.0, 2.0, 0.25)));
+  for (std::uint32_t minIterations : {4u, 0u}) {
+    WorldSettings ws;
+    ws.minSubstepIterations = minIterations;
+    World world(ws);
+    RigidBodyDesc ground;
+    ground.shape = slab;
+    ground.type = BodyType::kStatic;
+    world.addBody(ground);
+    RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
+    box.position = Vec3(0.0, 0.0, 1.5);
+    box.velocity = Vec3(0.0, 0.0, -20.0);
+    world.addBody(box);
+    bool spread = false, moreThanSpread = false;
+    for (int i = 0; i < 30; ++i) {
+      const StepReport& r = world.step(1.0 / 60.0);
+      const std::uint32_t n = r.substeps;
+      const std::uint32_t perSubstep =
+          minIterations == 0 ? 20u : std::min(20u, std::max(minIterations, (20u + n - 1) / n));
+      EXPECT_LE(r.solverIterations, (n + r.coldRestarts) * perSubstep) << "step " << i << " substeps " << n;
+      if (n > 1 && !r.contacts.empty() && perSubstep < 20u) spread = true;
+      if (r.solverIterations > (n + r.coldRestarts) * std::max(4u, (20u + n - 1) / n)) moreThanSpread = true;
+    }
+    if (minIterations > 0) {
+      EXPECT_TRUE(spread) << "no step had extra substeps and contacts: the test would prove nothing";
+    } else {
+      EXPECT_TRUE(moreThanSpread) << "with the rule off no step used more iterations than the rule allows";
+    }
+  }
 }
 
 TEST(World, SameSceneGivesBitIdenticalStates) {
