@@ -12,8 +12,11 @@ if(CLOD_SANITIZE)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   # Line tables are all a sanitizer report needs (file:line per frame); full debug info made the
   # CI's sanitizer build ~20% slower to compile (measured on src/narrowphase/query.cpp).
+  # -O1 (after the build type's -O2, so it wins): the sanitizer build compiled 1.5-2.4x faster
+  # than at -O2 (GCC 12, e.g. src/dynamics/world.cpp 84 -> 35 s CPU) and it is the optimisation
+  # level the AddressSanitizer documentation suggests; CI builds the whole tree twice on 2 cores.
   if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
-    add_compile_options(-g1)
+    add_compile_options(-g1 -O1)
   endif()
   add_link_options(-fsanitize=address,undefined)
 endif()
