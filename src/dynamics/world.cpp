@@ -118,6 +118,7 @@ struct World::Impl {
   std::vector<Vec3> savedV, savedW, dV, dW;
   std::map<std::uint64_t, PairReport> pairReports;
   std::uint32_t velocityIterationsNow = 20;
+  std::vector<double> stepTravel;
 
   void validateSettings() const {
     const WorldSettings& s = settings;
@@ -685,13 +686,28 @@ const StepReport& World::step(double dt) {
   Impl& m = *impl_;
   m.report = StepReport{};
   m.pairReports.clear();
+  // Substeps are for bodies that can touch something during the step: one whose box, grown by
+  // the distance it can move in the whole step, overlaps no other body's grown box cannot meet
+  // (or tunnel through) anything before the next step, however fast it is -- e.g. a body falling
+  // alone, or one that fell out of the bin (docs/dynamics.md: such bodies kept the whole bin at
+  // 13 substeps). The grown boxes are the substeps' broad-phase boxes over dt instead of h, so
+  // every pair a substep can find is among these.
   double maxTravel = 0.0, minExtent = std::numeric_limits<double>::infinity();
-  for (const Body& b : m.bodies) {
+  m.boxes.resize(m.bodies.size());
+  m.active.resize(m.bodies.size());
+  m.stepTravel.assign(m.bodies.size(), 0.0);
+  for (std::size_t i = 0; i < m.bodies.size(); ++i) {
+    const Body& b = m.bodies[i];
     minExtent = std::min(minExtent, std::max(b.minExtent, 1e-9));
-    if (b.type == BodyType::kStatic) continue;
-    const double speed = (b.v + m.settings.gravity * dt).norm() + b.w.norm() * 0.5 * b.localBox.diagonal();
-    maxTravel = std::max(maxTravel, speed * dt);
+    m.active[i] = b.type != BodyType::kStatic;
+    if (m.active[i]) {
+      const double speed = (b.v + m.settings.gravity * dt).norm() + b.w.norm() * 0.5 * b.localBox.diagonal();
+      m.stepTravel[i] = speed * dt;
+    }
+    m.boxes[i] = b.worldBox(m.stepTravel[i]);
   }
+  findOverlappingPairs(m.boxes, m.active.data(), m.candidates, m.bpScratch);
+  for (const BodyPair& c : m.candidates) maxTravel = std::max({maxTravel, m.stepTravel[c[0]], m.stepTravel[c[1]]});
   std::uint32_t n = m.settings.minSubsteps;
   if (std::isfinite(minExtent) && maxTravel > 0.0) {
     const double want = std::ceil(maxTravel / (kTravelFraction * minExtent));

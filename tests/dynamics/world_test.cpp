@@ -217,6 +217,44 @@ TEST(World, FastBallDoesNotTunnelThroughThinBox) {
   EXPECT_LE(world.state(1).velocity.x(), 1e-6);  // and stopped (restitution 0), not moving on
 }
 
+// Substeps are only for bodies that can touch something within the step (World::step): the same
+// ball at 50 m/s, 5 m from the wall, needs one substep per 1/60 s step while its path over the
+// step (0.83 m plus its radius) cannot reach the wall, and substeps again (0.83 m per step is 8x
+// a quarter of the 4 cm wall; n = ceil(travel / (0.25 x 0.04 m)) = 84) once it can; it still does
+// not pass through.
+TEST(World, FastBodyFarFromEverythingTakesOneSubstep) {
+  const auto ball = bakeShape(makeIcosphere(0.1, 2));
+  const auto wall = bakeShape(makeBox(Vec3(0.02, 1.0, 1.0)));
+  WorldSettings ws;
+  ws.gravity = Vec3::Zero();
+  World world(ws);
+  RigidBodyDesc w;
+  w.shape = wall;
+  w.type = BodyType::kStatic;
+  world.addBody(w);
+  RigidBodyDesc b;
+  b.shape = ball;
+  b.mass = 1.0;
+  b.inertia = Mat3::Identity() * (0.4 * 0.1 * 0.1);
+  b.position = Vec3(-5.0, 0.0, 0.0);
+  b.velocity = Vec3(50.0, 0.0, 0.0);
+  world.addBody(b);
+  bool substepped = false;
+  for (int i = 0; i < 12; ++i) {
+    const double gapBefore = -0.02 - (world.state(1).position.x() + 0.1);  // ball surface to wall face
+    const StepReport& r = world.step(1.0 / 60.0);
+    // The grown boxes overlap only once the gap is within one step's travel (50/60 m).
+    if (gapBefore > 50.0 / 60.0 + 1e-9) {
+      EXPECT_EQ(r.substeps, 1u) << "step " << i << " gap " << gapBefore;
+    } else if (gapBefore > 0.0) {
+      EXPECT_GT(r.substeps, 1u) << "step " << i << " gap " << gapBefore;
+      substepped = true;
+    }
+  }
+  EXPECT_TRUE(substepped) << "the ball never came near the wall: the test would prove nothing";
+  EXPECT_LT(world.state(1).position.x(), 0.0);   // still on the near side
+}
+
 TEST(World, NonFiniteStateStopsTheStepNamingTheBody) {
   // Gravity near the largest double over a long step overflows the velocity to infinity.
   WorldSettings ws;
