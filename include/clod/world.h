@@ -7,7 +7,9 @@
 // One step (World::step) of length dt:
 //   1. substeps: n = ceil(max speed * dt / (kTravelFraction * smallest body extent)), at most
 //      WorldSettings::maxSubsteps, so no body moves more than a fraction of the thinnest body's
-//      size per substep (anti-tunnelling by substepping; the narrow phase then sees overlap);
+//      size per substep (anti-tunnelling by substepping; the narrow phase then sees overlap); the
+//      max is over bodies whose box grown by their travel over dt overlaps another body's grown
+//      box (a body that cannot meet anything this step needs no substeps, however fast);
 //   2. per substep: gravity; broad phase (sweep and prune over world boxes of the root spheres);
 //      budget division among the candidate pairs (below); narrow phase (queryContacts) per pair;
 //      velocity solve (normal + 2 friction directions per contact, accumulated impulses clamped,
