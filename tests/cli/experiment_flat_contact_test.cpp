@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "clod/world.h"
 #include "cli_runner.h"
 #include "support/test_scale.h"
 
@@ -106,17 +107,26 @@ TEST(ExperimentFlatContactCli, ReferenceBoxRisesOverTheBumpButNotOnFlatGround) {
   // As the test above: the full experiment (10 s of resting contact per model) took 10 minutes of
   // the sanitizer run; the Release run covers it.
   if (clod::test::sanitizerRun()) GTEST_SKIP() << "10 s simulations per model: the Release run covers this test";
-  const clod::test::CliRun run = runCli("experiment flat-contact --trials 1 --json");
+  // Three starts, not one: a single sliding track is chaotic at the rounding level (moving B's
+  // corners with a rotation matrix instead of the quaternion, aa01b56, took the nominal start's
+  // lift from 26.3 to 17.5 mm; the three-start mean went 24.2 -> 21.2 mm, sd 3.4 mm).
+  const clod::test::CliRun run = runCli("experiment flat-contact --trials 3 --json");
   ASSERT_EQ(run.exitCode, 0) << run.err;
   const auto doc = nlohmann::json::parse(run.out);
   const double bumpHeight = doc["settings"]["bump_height"];
+  // The world's allowed penetration (WorldSettings::slopRel of the box's diagonal, the smaller
+  // body): each edge may rest that deep in what it stands on, lowering the centre by up to one slop.
+  const double boxHalf = doc["settings"]["box_half"];
+  const double slopMm = clod::WorldSettings{}.slopRel * 2.0 * std::sqrt(3.0) * boxHalf * 1e3;
   const auto& reference = doc["bump"][0];
   ASSERT_EQ(reference["model"], "exact");
   // The reference box (3 m/s, friction 0.2: it stops after v^2 / (2 mu g) ~ 2.3 m) reaches the
-  // bump and rises by at least half the bump's height while one side rides over it; on flat
-  // ground it never rises by more than a quarter of it (penetration slop is ~3.5 mm).
+  // bump and rises while one side rides over it: a rigid box tipped onto the bump by one edge
+  // lifts its centre by half the bump's height, less the slop. Ploughing through gives ~0 (cfm and
+  // dos in this experiment; the exact model gave -1.7 mm before 07e55db). On flat ground it never
+  // rises by more than a quarter of the bump's height (the slop is ~3.5 mm).
   EXPECT_GT(reference["final_x"].get<double>(), doc["settings"]["bump_center"][0].get<double>() - kBumpReach);
-  EXPECT_GT(reference["bump_lift_mm"].get<double>(), 0.5 * bumpHeight * 1e3);
+  EXPECT_GT(reference["bump_lift_mm"].get<double>(), 0.5 * bumpHeight * 1e3 - slopMm);
   EXPECT_LT(reference["flat_max_lift_mm"].get<double>(), 0.25 * bumpHeight * 1e3);
 }
 
