@@ -7,6 +7,8 @@
 // "dt" (s, default 1/60), "steps" or "duration" (s; default 120 steps), "contact_model"
 // (contact.h names, default "cfm"), "budget" (tests per frame, 0 = unlimited), "max_contacts",
 // "min_substeps" (WorldSettings::minSubsteps, default 1; tall stacks need ~8),
+// "min_substep_iterations" (WorldSettings::minSubstepIterations, 0..20, default 4),
+// "frontier_pair_cost" (WorldSettings::frontierPairCost, 0..1024, default 2),
 // "bounds" {"min": [..], "max": [..]}, "bodies" [ ... ]. Body keys: "name", exactly one of
 // "mesh" (path relative to the scene file), "box" [hx,hy,hz] (half extents) or "sphere" r;
 // "position", "orientation" [w,x,y,z], "velocity", "angular_velocity", "density" or "mass"

@@ -149,7 +149,8 @@ SceneDescription parseScene(std::string_view text, const std::filesystem::path& 
   } catch (const Json::parse_error& e) {
     throw Error(ErrorCode::kSceneError, fileName + ": not valid JSON: " + e.what());
   }
-  r.object(j, "", {"gravity", "dt", "steps", "duration", "contact_model", "budget", "max_contacts", "min_substeps", "bounds", "bodies"});
+  r.object(j, "", {"gravity", "dt", "steps", "duration", "contact_model", "budget", "max_contacts", "min_substeps",
+                  "min_substep_iterations", "frontier_pair_cost", "bounds", "bodies"});
   SceneDescription s;
   if (j.contains("gravity")) s.world.gravity = r.vec<3>(j["gravity"], "gravity");
   if (j.contains("dt")) s.dt = r.positive(j["dt"], "dt");
@@ -173,6 +174,11 @@ SceneDescription parseScene(std::string_view text, const std::filesystem::path& 
   if (j.contains("max_contacts")) s.world.maxContacts = std::uint32_t(r.count(j["max_contacts"], "max_contacts", 1, 1024));
   if (j.contains("min_substeps"))
     s.world.minSubsteps = std::uint32_t(r.count(j["min_substeps"], "min_substeps", 1, s.world.maxSubsteps));
+  if (j.contains("min_substep_iterations"))
+    s.world.minSubstepIterations =
+        std::uint32_t(r.count(j["min_substep_iterations"], "min_substep_iterations", 0, s.world.velocityIterations));
+  if (j.contains("frontier_pair_cost"))
+    s.world.frontierPairCost = std::uint32_t(r.count(j["frontier_pair_cost"], "frontier_pair_cost", 0, 1024));
   if (j.contains("bounds")) {
     r.object(j["bounds"], "bounds", {"min", "max"});
     if (!j["bounds"].contains("min") || !j["bounds"].contains("max")) r.fail("bounds", "needs \"min\" and \"max\"");
