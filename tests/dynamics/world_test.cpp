@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -52,6 +53,15 @@ RigidBodyDesc dynamicBox(const std::shared_ptr<const CollisionBody>& shape, cons
   d.inertia(1, 1) = mass / 3.0 * (halfExtents.x() * halfExtents.x() + halfExtents.z() * halfExtents.z());
   d.inertia(2, 2) = mass / 3.0 * (halfExtents.x() * halfExtents.x() + halfExtents.y() * halfExtents.y());
   return d;
+}
+
+// A static body (the ground every drop test lands on).
+void addStaticGround(World& world, const std::shared_ptr<const CollisionBody>& shape, const std::string& name = "") {
+  RigidBodyDesc ground;
+  ground.name = name;
+  ground.shape = shape;
+  ground.type = BodyType::kStatic;
+  world.addBody(ground);
 }
 
 double tiltDegrees(const Quat& q) {
@@ -124,11 +134,7 @@ TEST(World, BoxDroppedFlatComesToRestFlatWithEveryModelAndBudget) {
       ws.model = model;
       ws.budgetTests = budget;
       World world(ws);
-      RigidBodyDesc ground;
-      ground.name = "ground";
-      ground.shape = slab;
-      ground.type = BodyType::kStatic;
-      world.addBody(ground);
+      addStaticGround(world, slab, "ground");
       RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
       box.name = "box";
       box.position = Vec3(0.1, -0.05, 1.5);
@@ -161,11 +167,7 @@ TEST(World, StackOfTenBoxesStandsForTenSeconds) {
   ws.velocityIterations = 20;
   ws.minSubsteps = 8;
   World world(ws);
-  RigidBodyDesc ground;
-  ground.shape = slab;
-  ground.name = "ground";
-  ground.type = BodyType::kStatic;
-  world.addBody(ground);
+  addStaticGround(world, slab, "ground");
   for (int i = 0; i < 10; ++i) {
     RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
     box.name = "box" + std::to_string(i);
@@ -317,10 +319,7 @@ TEST(World, BudgetBoundsTheTestsOfEveryFrame) {
   WorldSettings ws;
   ws.budgetTests = 40;
   World world(ws);
-  RigidBodyDesc ground;
-  ground.shape = slab;
-  ground.type = BodyType::kStatic;
-  world.addBody(ground);
+  addStaticGround(world, slab);
   for (int i = 0; i < 8; ++i) {
     RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
     box.position = Vec3(-2.0 + 0.55 * i, 0.0, 0.8 + 0.3 * i);
@@ -352,10 +351,7 @@ TEST(World, BudgetCountsFrontierPairs) {
     ws.budgetTests = 40;
     ws.frontierPairCost = cost;
     World world(ws);
-    RigidBodyDesc ground;
-    ground.shape = slab;
-    ground.type = BodyType::kStatic;
-    world.addBody(ground);
+    addStaticGround(world, slab);
     for (int i = 0; i < 8; ++i) {
       RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
       box.position = Vec3(-1.65 + 1.1 * (i % 4), i < 4 ? -0.55 : 0.55, 0.8 + 0.05 * i);
@@ -399,10 +395,7 @@ TEST(World, ExtraSubstepsShareTheStepsVelocityIterations) {
     WorldSettings ws;
     ws.minSubstepIterations = minIterations;
     World world(ws);
-    RigidBodyDesc ground;
-    ground.shape = slab;
-    ground.type = BodyType::kStatic;
-    world.addBody(ground);
+    addStaticGround(world, slab);
     RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
     box.position = Vec3(0.0, 0.0, 1.5);
     box.velocity = Vec3(0.0, 0.0, -20.0);
@@ -431,10 +424,7 @@ TEST(World, SameSceneGivesBitIdenticalStates) {
     WorldSettings ws;
     ws.budgetTests = 64;
     World world(ws);
-    RigidBodyDesc ground;
-    ground.shape = slab;
-    ground.type = BodyType::kStatic;
-    world.addBody(ground);
+    addStaticGround(world, slab);
     for (int i = 0; i < 5; ++i) {
       RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
       box.position = Vec3(0.3 * i, 0.1 * i, 1.0 + 1.1 * i);
