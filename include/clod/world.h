@@ -39,8 +39,9 @@
 // keep its frontier -- at most max(cached front, tests) pairs -- within what it may spend: a pair
 // whose cached front costs more than the substep has left waits for the next substep (it is then
 // ranked first), and one whose front costs more than a substep's even share restarts from the
-// roots. dos pairs with an immovable body get at least their front + 8 tests (or wait), so they
-// can get below the root spheres (docs/dynamics.md, the bin).
+// roots. A dos pair with an immovable body whose query the budget interrupted answers along the
+// immovable body's box-outward direction instead of the D&O centre line (docs/dynamics.md, "dos
+// against immovable bodies"); finished dos queries keep their D&O normals.
 //
 // Energy: the velocity solve is checked -- if the warm-started solve ends with more kinetic energy
 // than it started with, it is redone from zero impulses -- and the restitution impulses are scaled

@@ -89,6 +89,7 @@ struct PairState {
   double priority = 0.0;
   bool seen = false;         // in this substep's broad phase
   bool fresh = false;        // queried this substep (else: skipped, contacts kept)
+  bool interrupted = false;  // the last query stopped at its budget (QueryResult::finished false)
 };
 
 std::uint64_t pairKey(BodyId a, BodyId b) { return (std::uint64_t(a) << 32) | b; }
@@ -98,6 +99,15 @@ void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
   const Vec3 a = std::abs(n.x()) < 0.57735 ? Vec3::UnitX() : (std::abs(n.y()) < 0.57735 ? Vec3::UnitY() : Vec3::UnitZ());
   t1 = n.cross(a).normalized();
   t2 = n.cross(t1);
+}
+
+// Outward unit direction of body `fixed`'s oriented bounding box (its mesh bounds, turned and
+// placed with the body) from the box point nearest `p` to `p`; zero for p inside the box.
+Vec3 outwardFromBox(const Body& fixed, const Vec3& p) {
+  const Vec3 local = fixed.q.conjugate() * (p - fixed.x) + fixed.comLocal;  // mesh coordinates
+  const Vec3 d = local - local.cwiseMax(fixed.localBox.min).cwiseMin(fixed.localBox.max);
+  const double length = d.norm();
+  return length > 0.0 ? Vec3(fixed.q * (d / length)) : Vec3::Zero();
 }
 
 }  // namespace
@@ -293,24 +303,6 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
         const std::uint64_t withinFront = std::min(front, grant - perCell * front);  // T <= F
         const std::uint64_t beyondFront = grant / (1 + perCell);                     // T > F
         share = std::max(withinFront, beyondFront > front ? beyondFront : 0);
-      } else if (s.model == ContactModel::kDos && (a.invMass == 0.0) != (bb.invMass == 0.0)) {
-        // D&O contacts carry no surface: a pair's answer at its root spheres is the centre line,
-        // which for a body near the edge of a large static floor is nearly horizontal and lets
-        // the body slide through (docs/dynamics.md, the bin). Such a pair gets at least enough
-        // tests to retest its front and expand one pair (8 children per sphere at most with the
-        // default SphereTreeSettings::branching; an interrupted expansion is dropped, so with
-        // fewer tests a root front never gets below the roots), or waits for its turn. The other
-        // models' coarse contacts carry a surface normal (cfm's maps, exact's cfm fallback, the
-        // contact tree's half-spaces); for them the same rule measured worse (more bodies lost at
-        // 1,024 tests per frame).
-        const std::uint64_t useful = std::min<std::uint64_t>(std::max<std::uint64_t>(1, p->cache.frontSize()) + 8, nominal);
-        if (share < useful) {
-          if (useful > remaining) {
-            skip();
-            continue;
-          }
-          share = useful;
-        }
       }
       qs.budget = QueryBudget::tests(share);
     } else {
@@ -329,6 +321,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     pr.finished = result.finished;
     pr.skipped = false;
     if (!result.finished) ++report.pairsInterrupted;
+    p->interrupted = !result.finished;
     p->stale = 0;
     p->fresh = true;
     p->previous.swap(p->contacts);
@@ -355,6 +348,26 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     Body& b = bodies[ids[1]];
     const double restitution = std::max(a.desc.restitution, b.desc.restitution);
     const double diag = std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal());
+    const bool aFixed = a.invMass == 0.0, bFixed = b.invMass == 0.0;
+    if (s.model == ContactModel::kDos && aFixed != bFixed && p->interrupted) {
+      // A D&O contact's normal is the centre line of two bounding spheres: it carries no surface.
+      // Against an immovable body it is the moving body's whole support, and from the big spheres
+      // a query stopped by the budget leaves it at -- a floor slab's root or first levels -- it
+      // leans toward the horizontal, the more the deeper the body sinks: in the 200-body bin bodies
+      // slid down through the floor and fell until they left the bounds (the "energy gain" of
+      // the dos rows was their free fall: docs/dynamics.md, "dos against immovable bodies"). So
+      // an interrupted pair's D&O contacts against an immovable body fall back to that body's
+      // own surface direction: the outward direction of its oriented bounding box from the point
+      // nearest the moving body's centre of mass. A centre inside the box (a sunken body, or one
+      // inside a concave static mesh's box) keeps the D&O normal: the box says nothing there. A
+      // finished query (unlimited budget, or a level cap: the experiments that compare normals,
+      // e.g. `clod experiment landing`) keeps pure D&O normals. Done before persistContacts, so
+      // the anchors and the warm-start matching see the normal the solver uses.
+      const Vec3 n = outwardFromBox(aFixed ? a : b, (aFixed ? b : a).x);
+      if (n.squaredNorm() > 0.0)
+        for (SolverContact& cp : p->contacts)
+          if (cp.c.errorBound > 0.0) cp.c.normal = aFixed ? Vec3(-n) : n;
+    }
     if (p->fresh) persistContacts(*p, a, b, diag);
     double maxDepth = 0.0;
     double approach = 0.0;
@@ -366,7 +379,6 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     // replaced by the outward direction of the immovable body's world box at the point nearest
     // the moving body's centre of mass (only when that centre is outside the box; inside, the
     // box says nothing). Exact and contact-tree contacts are trusted as they are.
-    const bool aFixed = a.invMass == 0.0, bFixed = b.invMass == 0.0;
     if (aFixed != bFixed) {
       const Body& moving = aFixed ? b : a;
       const Aabb box = (aFixed ? a : b).worldBox(0.0);

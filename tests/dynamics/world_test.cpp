@@ -2,6 +2,7 @@
 // tunnelling. Every tolerance is justified where it is used.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
@@ -416,6 +417,89 @@ TEST(World, ExtraSubstepsShareTheStepsVelocityIterations) {
       EXPECT_TRUE(moreThanSpread) << "with the rule off no step used more iterations than the rule allows";
     }
   }
+}
+
+// The 200-body bin's dos rows "gained" up to 411 kJ of kinetic energy and lost 66 bodies at 1,024
+// tests per frame (docs/benchmarks/world.md, d423c41). No energy was created: KE + PE only fell
+// (the solver dissipates, integration conserves); the kinetic energy was that of bodies in free
+// fall below the floor, which they had slid through on D&O contacts whose normals -- centre lines
+// of the floor's big bounding spheres -- lean toward the horizontal (docs/dynamics.md, "dos
+// against immovable bodies"). Here a smaller bin (slab floor, four walls, the bin's 0.3 m cubes
+// and balls, 75 of them) at a budget as tight per body as 1,024 tests for 200 bodies, dos
+// contacts. Oracles: the geometry (every
+// centre of mass stays inside the walls and above the floor's top face) and the energy
+// (KE + PE never above its initial value: gravity is the only external force and it is
+// conservative, restitution is 0.1, the walls are static).
+TEST(World, DosPileInAStaticBinStaysInAndGainsNoEnergy) {
+  const auto floorShape = bakeShape(makeBox(Vec3(1.1, 1.1, 0.2)));
+  const auto wallX = bakeShape(makeBox(Vec3(0.2, 1.1, 0.75)));
+  const auto wallY = bakeShape(makeBox(Vec3(1.5, 0.2, 0.75)));
+  const auto cube = bakeShape(makeBox(Vec3(0.15, 0.15, 0.15)));
+  const auto ball = bakeShape(makeIcosphere(0.15, 2));
+  WorldSettings ws;
+  ws.model = ContactModel::kDos;
+  ws.maxContacts = 4;  // as scenes/bin_200.json
+  ws.bounds = Aabb{Vec3::Constant(-20.0), Vec3::Constant(20.0)};
+  World world(ws);
+  auto addStatic = [&](const std::shared_ptr<const CollisionBody>& shape, const Vec3& at) {
+    RigidBodyDesc d;
+    d.shape = shape;
+    d.type = BodyType::kStatic;
+    d.position = at;
+    d.friction = 0.5;
+    world.addBody(d);
+  };
+  addStatic(floorShape, Vec3(0.0, 0.0, -0.2));  // top face at z = 0
+  addStatic(wallX, Vec3(-1.3, 0.0, 0.55));      // inner faces at |x| = 1.1, |y| = 1.1
+  addStatic(wallX, Vec3(1.3, 0.0, 0.55));
+  addStatic(wallY, Vec3(0.0, -1.3, 0.55));
+  addStatic(wallY, Vec3(0.0, 1.3, 0.55));
+  const std::size_t first = world.bodyCount();
+  const int layers = sanitizerRun() ? 1 : 3;
+  for (int k = 0; k < layers; ++k)
+    for (int i = 0; i < 5; ++i)
+      for (int j = 0; j < 5; ++j) {
+        const bool isBall = (i + j + k) % 2 == 1;
+        RigidBodyDesc d = dynamicBox(isBall ? ball : cube, Vec3(0.15, 0.15, 0.15), 1.0);
+        if (isBall) d.inertia = Mat3::Identity() * (0.4 * 0.15 * 0.15);  // solid ball 2/5 m r^2
+        d.name = (isBall ? "ball" : "cube") + std::to_string(world.bodyCount());
+        d.position = Vec3(-0.8 + 0.4 * i + 0.02 * k, -0.8 + 0.4 * j, 0.3 + 0.4 * k);
+        d.friction = 0.5;
+        d.restitution = 0.1;
+        world.addBody(d);
+      }
+  const std::size_t bodies = world.bodyCount() - first;
+  // 1,024 tests per frame for the 200-body bin: ~5 per body.
+  world.setBudgetTests(5 * bodies);
+  const double energy0 = world.kineticEnergy() + world.potentialEnergy();
+  const double weight = 9.81 * double(bodies);  // total m g (1 kg each)
+  double maxRise = -HUGE_VAL, lowest = HUGE_VAL, widest = 0.0;
+  std::size_t left = 0;
+  for (int step = 0; step < 150; ++step) {  // 2.5 s: the pile lands and settles
+    left += world.step(1.0 / 60.0).leftBounds.size();
+    maxRise = std::max(maxRise, world.kineticEnergy() + world.potentialEnergy() - energy0);
+    for (std::size_t b = first; b < world.bodyCount(); ++b) {
+      const Vec3 c = world.state(b).position;  // the centre of mass (bodies built about it)
+      lowest = std::min(lowest, c.z());
+      widest = std::max({widest, std::abs(c.x()), std::abs(c.y())});
+    }
+  }
+  EXPECT_EQ(left, 0u);
+  std::printf("dos pile: %zu bodies, lowest z %.3f, widest %.3f, KE+PE max rise %.3g J, KE at end %.3g J\n", bodies,
+              lowest, widest, maxRise, world.kineticEnergy());
+  // Above the floor's top face: a body resting on D&O spheres may sink into the floor by up to
+  // its half size (0.15 m; its bounding sphere overlapping the floor's), never through it.
+  EXPECT_GT(lowest, 0.0) << "lowest centre of mass z " << lowest;
+  EXPECT_LT(widest, 1.1) << "largest |x|, |y| of a centre of mass " << widest;  // inside the walls' inner faces
+  // Split-impulse position correction lifts a penetrating body without touching its velocity,
+  // which raises PE by at most m g times the penetration it removes; a body's correction is
+  // capped at 2 % of the smaller diagonal per substep (kMaxCorrectionRel) and only removes what
+  // the contact is sure of. So the bound is the whole pile's weight times 2 % of a body's
+  // diagonal (0.3 sqrt 3 m: ~1 cm), about 1.5 % of the pile's initial PE above its rest.
+  // Measured before the fix (d423c41's world): the rise never went above 0 either -- the energy
+  // was never created; what failed was the geometry (a centre of mass 6.5 cm below the floor).
+  const double diagonal = 0.3 * std::sqrt(3.0);
+  EXPECT_LT(maxRise, weight * 0.02 * diagonal) << "max rise " << maxRise << " J";
 }
 
 TEST(World, SameSceneGivesBitIdenticalStates) {
