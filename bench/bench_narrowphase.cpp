@@ -23,6 +23,9 @@
 // depth error = |deepest contact's depth - the exact depth|; point error = distance between the
 // manifolds' centroids; lengths in units of the diagonal (1). Times are this thread's CPU time of
 // the one call. Prints a markdown table of medians and 95th percentiles.
+// --reference=volume compares with the independent volume-gradient reference of tests/support/overlap_reference.h
+// instead of the exact model (which then becomes one row like the others; poses unchanged), and
+// --reference-resolution=R sets its leaf radius in diagonals (default 2.5e-4, 1/20 of the overlap).
 // --accuracy-models=cfm,exact and --accuracy-meshes=bunny,fandisk restrict the rows (names
 // as printed, comma-separated; FCL and Bullet are the models "fcl" and "bullet"); the poses stay the
 // same (same seeds), so restricted runs compare row by row with full ones.
@@ -45,6 +48,7 @@
 #include "clod/primitives.h"
 #include "clod/proximity.h"
 #include "clod/query.h"
+#include "support/overlap_reference.h"
 
 #if defined(CLOD_BENCH_HAVE_FCL)
 #include <fcl/narrowphase/collision.h>
@@ -85,6 +89,7 @@ struct BulletMesh {
 
 struct Body {
   std::unique_ptr<CollisionBody> body;
+  std::unique_ptr<MeshDistance> distance;  // the mesh's exact distance field (contact tree, reference)
 #if defined(CLOD_BENCH_HAVE_FCL)
   std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> fcl;
 #endif
@@ -106,7 +111,8 @@ const Body& body(int index) {
   ContactTreeSettings ct;
   ct.errorRel = 2e-3;
   ct.maxDepth = 7;
-  b->body->setContactTree(buildContactTree(MeshDistance(mesh), ct));
+  b->distance = std::make_unique<MeshDistance>(mesh);
+  b->body->setContactTree(buildContactTree(*b->distance, ct));
 #if defined(CLOD_BENCH_HAVE_FCL)
   b->fcl = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
   b->fcl->beginModel();
@@ -331,7 +337,14 @@ bool selected(const char* list, const std::string& name) {
   return l.find("," + name + ",") != std::string::npos;
 }
 
-void runAccuracy(int poses, const char* dataPath, const char* models, const char* meshes) {
+// What the accuracy harness compares against: clod's exact model at full budget, or the
+// independent volume-gradient reference of tests/support/overlap_reference.h (--reference=volume).
+struct Reference {
+  bool volume = false;
+  double resolution = 2.5e-4;  // leaf radius of the volume reference (diag): 1/20 of the 0.005 overlap
+};
+
+void runAccuracy(int poses, const char* dataPath, const char* models, const char* meshes, const Reference& reference) {
   std::FILE* data = dataPath != nullptr ? std::fopen(dataPath, "w") : nullptr;
   if (data != nullptr) {
     std::fprintf(data, "# budget 0 = unlimited; FCL/Bullet rows have budget -\n# mesh method budget time_us_median normal_deg_median normal_deg_p95 depth_err_median point_err_median\n");
@@ -346,6 +359,8 @@ void runAccuracy(int poses, const char* dataPath, const char* models, const char
     std::uniform_real_distribution<double> uni(-1.0, 1.0);
     // methods: 5 models x 5 budgets, then FCL, Bullet
     std::vector<Samples> samples(27);
+    std::vector<double> consistency, referenceMicros;  // volume reference: its own accuracy and cost
+    int noOverlap = 0;
     QueryScratch scratch;
     QueryResult exact, r;
     for (int k = 0; k < poses; ++k) {
@@ -357,9 +372,23 @@ void runAccuracy(int poses, const char* dataPath, const char* models, const char
       s.model = ContactModel::kExact;
       queryContacts(a, Pose{}, a, pb, s, scratch, exact);
       if (exact.contacts.empty()) continue;
-      const Vec3 nRef = resultantNormal(exact.contacts);
-      const Vec3 cRef = centroid(exact.contacts);
-      const double dRef = maxDepth(exact.contacts);
+      Vec3 nRef = resultantNormal(exact.contacts);
+      Vec3 cRef = centroid(exact.contacts);
+      double dRef = maxDepth(exact.contacts);
+      if (reference.volume) {
+        const MeshDistance& distance = *body(mesh).distance;
+        const double t0 = threadSeconds();
+        const test::OverlapReference volume = test::overlapReference(distance, Pose{}, distance, pb, reference.resolution);
+        referenceMicros.push_back((threadSeconds() - t0) * 1e6);
+        if (volume.area == 0 || volume.normal().norm() == 0) {
+          ++noOverlap;
+          continue;
+        }
+        consistency.push_back(volume.selfConsistencyDegrees());
+        nRef = volume.normal();
+        cRef = volume.centroid;
+        dRef = volume.depth;
+      }
       auto record = [&](Samples& out, double seconds, bool any, const Vec3& n, const Vec3& c, double depth) {
         out.micros.push_back(seconds * 1e6);
         if (!any) {
@@ -440,6 +469,13 @@ void runAccuracy(int poses, const char* dataPath, const char* models, const char
     }
     row("FCL OBBRSS", "-", samples[25]);
     row("Bullet GImpact", "-", samples[26]);
+    if (reference.volume) {
+      std::printf("\n%s: volume-gradient reference (leaf radius %.1e) on %zu poses (%d without overlap skipped): "
+                  "self-consistency (angle between the two surface integrals) median %.2f deg, p95 %.2f deg; "
+                  "%.0f ms CPU per pose (median)\n\n",
+                  kMeshNames[mesh], reference.resolution, consistency.size(), noOverlap, percentile(consistency, 0.5),
+                  percentile(consistency, 0.95), percentile(referenceMicros, 0.5) / 1e3);
+    }
   }
   if (data != nullptr) std::fclose(data);
 }
@@ -450,7 +486,12 @@ int main(int argc, char** argv) {
   const char* dataPath = nullptr;
   const char* models = nullptr;
   const char* meshes = nullptr;
+  Reference reference;
   for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--reference=volume") == 0) reference.volume = true;
+    if (std::strncmp(argv[i], "--reference-resolution=", 23) == 0) {
+      reference.resolution = std::clamp(std::atof(argv[i] + 23), 1e-6, 1.0);
+    }
     if (std::strncmp(argv[i], "--accuracy-data=", 16) == 0) dataPath = argv[i] + 16;
     if (std::strncmp(argv[i], "--accuracy-models=", 18) == 0) models = argv[i] + 18;
     if (std::strncmp(argv[i], "--accuracy-meshes=", 18) == 0) meshes = argv[i] + 18;
@@ -458,7 +499,7 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (std::strncmp(argv[i], "--accuracy", 10) == 0 && (argv[i][10] == '=' || argv[i][10] == 0)) {
       const int poses = argv[i][10] == '=' ? std::atoi(argv[i] + 11) : 2000;
-      runAccuracy(std::max(1, poses), dataPath, models, meshes);
+      runAccuracy(std::max(1, poses), dataPath, models, meshes, reference);
       return 0;
     }
   }

@@ -9,3 +9,7 @@ if(TARGET bench_narrowphase)
   endif()
   clod_bench_link_bullet(bench_narrowphase "Bullet GImpact")
 endif()
+# The accuracy harness's independent reference (--reference=volume) is shared with the tests.
+if(TARGET bench_narrowphase)
+  target_include_directories(bench_narrowphase PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+endif()

@@ -3,11 +3,17 @@
 #   ./build-narrow/bin/bench_narrowphase --accuracy=1000 --accuracy-data=docs/benchmarks/narrowphase_accuracy.dat
 # Plot (from the repository root):
 #   gnuplot docs/benchmarks/narrowphase_accuracy.gp
+# The same plot against the independent volume-gradient reference (--reference=volume):
+#   ./build-narrow/bin/bench_narrowphase --accuracy=300 --reference=volume --accuracy-data=docs/benchmarks/narrowphase_accuracy_volume.dat
+#   gnuplot -e "data='docs/benchmarks/narrowphase_accuracy_volume.dat'; output='docs/benchmarks/narrowphase_accuracy_volume.png'; reference='the volume-gradient reference'; poses=300" docs/benchmarks/narrowphase_accuracy.gp
 # Columns: mesh method budget time_us normal_deg_median normal_deg_p95 depth_err_median point_err_median
 set terminal pngcairo size 1500,900 font "sans,10"
-set output "docs/benchmarks/narrowphase_accuracy.png"
-data = "docs/benchmarks/narrowphase_accuracy.dat"
-set multiplot layout 2,3 title "Narrow phase: median error vs median CPU time per query (1000 random touching poses per mesh; budgets 16, 64, 256, 1024, unlimited along each line)"
+if (!exists("data")) data = "docs/benchmarks/narrowphase_accuracy.dat"
+if (!exists("output")) output = "docs/benchmarks/narrowphase_accuracy.png"
+if (!exists("reference")) reference = "the exact model"
+if (!exists("poses")) poses = 1000
+set output output
+set multiplot layout 2,3 title sprintf("Narrow phase: median error against %s vs median CPU time per query (%d random touching poses per mesh; budgets 16, 64, 256, 1024, unlimited along each line)", reference, poses)
 set logscale x
 set grid
 set key top right font ",9"
