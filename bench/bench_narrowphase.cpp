@@ -3,6 +3,10 @@
 // accuracy harness (normal and point error against the exact model over random touching poses).
 //
 //   BM_NarrowPhase_Query/<mesh>/<pose>/<model>/<budget>   clod queryContacts, scratch reused
+//   BM_NarrowPhase_Deadline/<mesh>/deep/<model>/<T>us     a deadline T µs from the call instead of a test
+//                                                         count: overrun past the deadline (counters);
+//                                                         ".../answer_after_deadline": with
+//                                                         QueryBudget::answerWithinDeadline off
 //   BM_NarrowPhase_Fcl/<mesh>/<pose>                      fcl::collide, OBBRSS, all contacts
 //   BM_NarrowPhase_Bullet/<mesh>/<pose>                   btCollisionWorld with two GImpact shapes
 //
@@ -201,6 +205,36 @@ void BM_NarrowPhase_Query(benchmark::State& state, int mesh, int pose, ContactMo
   state.counters["contacts"] = static_cast<double>(result.contacts.size());
   state.counters["tests"] = static_cast<double>(result.tests);
   state.counters["finished"] = result.finished ? 1.0 : 0.0;
+}
+
+// A deadline instead of a test count: the query must return by the deadline plus at most one
+// batch of work (budget.h). Counters: overrun_us_p50 / _p99 (return time - deadline, wall clock,
+// over the iterations), tests, frontier and pairs_answered (last iteration), contacts.
+void BM_NarrowPhase_Deadline(benchmark::State& state, int mesh, int pose, ContactModel model, double micros,
+                             bool answerWithinDeadline) {
+  const CollisionBody& a = *body(mesh).body;
+  const Pose pb = benchPose(mesh, pose);
+  QuerySettings s;
+  s.model = model;
+  QueryScratch scratch;
+  QueryResult result;
+  std::vector<double> overruns;
+  overruns.reserve(1 << 16);
+  for (auto _ : state) {
+    s.budget = QueryBudget::microsecondsFromNow(micros);
+    s.budget.answerWithinDeadline = answerWithinDeadline;
+    queryContacts(a, Pose{}, a, pb, s, scratch, result);
+    overruns.push_back(std::chrono::duration<double, std::micro>(QueryBudget::Clock::now() - s.budget.deadline).count());
+    benchmark::DoNotOptimize(result.contacts.data());
+  }
+  std::sort(overruns.begin(), overruns.end());
+  const auto at = [&](double q) { return overruns.empty() ? 0.0 : overruns[static_cast<std::size_t>(q * double(overruns.size() - 1))]; };
+  state.counters["overrun_us_p50"] = at(0.5);
+  state.counters["overrun_us_p99"] = at(0.99);
+  state.counters["pairs_answered"] = static_cast<double>(result.pairsAnswered);
+  state.counters["frontier"] = static_cast<double>(result.frontier.size());
+  state.counters["contacts"] = static_cast<double>(result.contacts.size());
+  state.counters["tests"] = static_cast<double>(result.tests);
 }
 
 #if defined(CLOD_BENCH_HAVE_FCL)
@@ -512,6 +546,19 @@ int main(int argc, char** argv) {
                                    (budget == kUnlimitedTests ? std::string("unlimited") : std::to_string(budget));
           benchmark::RegisterBenchmark(name.c_str(), BM_NarrowPhase_Query, mesh, pose, model, budget)
               ->Unit(benchmark::kMicrosecond);
+        }
+      }
+      if (pose == 0) {
+        for (ContactModel model : {ContactModel::kCfm, ContactModel::kContactTree, ContactModel::kExact}) {
+          for (double micros : {10.0, 30.0, 100.0}) {
+            for (bool within : {true, false}) {
+              const std::string name = "BM_NarrowPhase_Deadline/" + prefix + "/" + std::string(contactModelName(model)) +
+                                       "/" + std::to_string(static_cast<int>(micros)) + "us" +
+                                       (within ? "" : "/answer_after_deadline");
+              benchmark::RegisterBenchmark(name.c_str(), BM_NarrowPhase_Deadline, mesh, pose, model, micros, within)
+                  ->Unit(benchmark::kMicrosecond);
+            }
+          }
         }
       }
 #if defined(CLOD_BENCH_HAVE_FCL)

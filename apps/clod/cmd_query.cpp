@@ -141,7 +141,7 @@ const CommandRegistration kRegistration("query", [](CLI::App& app) {
   sub->add_option("--pose-b", options->poseB, "Pose of B, same form")->capture_default_str();
   sub->add_option("--model", options->model, "Contact model: dos, average, cfm, contact-tree, exact")->capture_default_str();
   sub->add_option("--budget", options->budget, "Most sphere/triangle tests (default: unlimited)");
-  sub->add_option("--deadline-us", options->deadlineUs, "Wall-clock deadline in microseconds (checked every 32 tests)");
+  sub->add_option("--deadline-us", options->deadlineUs, "Wall-clock deadline in microseconds; the traversal stops early enough that turning its frontier into contacts ends by it too (include/clod/budget.h)");
   sub->add_option("--max-contacts", options->maxContacts, "Manifold size, 1..1024")->capture_default_str();
   sub->add_flag("--json", options->json, "Print the result as JSON (colliding, contacts, tests, finished, seconds)");
   return [options] { return runQuery(*options); };

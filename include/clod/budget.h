@@ -9,9 +9,20 @@
 //
 // Deadline: the clock is read once per batch of kDeadlineBatch tests, before the batch starts,
 // and never before the first batch (so a query whose deadline has already passed still makes
-// up to kDeadlineBatch tests, and queries of fewer tests never read the clock). A query
-// therefore overruns its deadline by at most one batch of tests plus turning its frontier into
-// contacts.
+// up to kDeadlineBatch tests, and queries of fewer tests never read the clock).
+//
+// The answer (turning the frontier into contacts) is inside the deadline too, unless
+// answerWithinDeadline is false: the traversal stops when the time left no longer covers
+// answering its current frontier at the per-pair cost its QueryScratch has measured
+// (QueryScratch::answerSecondsPerPair), and the answer itself reads the clock once per batch of
+// frontier pairs (8 sphere pairs, or one contact-tree cell pair; not before the first batch) and
+// leaves the rest of the frontier unanswered once the deadline has passed
+// (QueryResult::pairsAnswered) -- unless it has no contact yet: then up to kDeadlineBatch more
+// pairs are answered until one gives a contact. A query therefore overruns its deadline by at
+// most one batch of tests, one batch of frontier pairs (plus those kDeadlineBatch pairs when the
+// first ones gave nothing) and the manifold reduction of the contacts answered. With
+// answerWithinDeadline false the traversal stops at the deadline and the whole frontier is
+// answered, however long that takes.
 
 #include <chrono>
 #include <cstdint>
@@ -36,6 +47,8 @@ struct QueryBudget {
   /// The clock the deadline is read from; replaceable so tests can count clock reads instead
   /// of timing. Must be non-null.
   TimePoint (*now)() = &Clock::now;
+  /// Keep turning the frontier into contacts within the deadline as well (see above).
+  bool answerWithinDeadline = true;
 
   /// Unlimited: run to the leaves.
   static QueryBudget unlimited() { return {}; }

@@ -125,6 +125,9 @@ struct QueryResult {
   /// Exact model only: the intersecting (triangle of A, triangle of B) pairs found, sorted,
   /// each once. Empty for the other models.
   std::vector<std::array<std::uint32_t, 2>> intersectingTriangles;
+  /// Frontier pairs turned into contacts: all of `frontier`, unless a deadline cut the answer
+  /// short (QueryBudget::answerWithinDeadline); then the first ones in traversal order.
+  std::uint64_t pairsAnswered = 0;
   /// Wall-clock seconds the query took.
   double seconds = 0.0;
 };
@@ -137,6 +140,13 @@ public:
   ~QueryScratch();
   QueryScratch(QueryScratch&&) noexcept;
   QueryScratch& operator=(QueryScratch&&) noexcept;
+  /// Seconds per frontier pair that turning a frontier into contacts takes with `model`: a
+  /// deadline query stops its traversal this much per frontier pair before the deadline, so its
+  /// answer ends by the deadline too (QueryBudget::answerWithinDeadline). Learned from this
+  /// scratch's deadline queries (exponential average over answers of at least 8 pairs); set it to seed or pin the estimate (finite, >= 0; kInvalidArgument otherwise).
+  double answerSecondsPerPair(ContactModel model) const noexcept;
+  void setAnswerSecondsPerPair(ContactModel model, double seconds);
+
   struct Impl;
   Impl& impl() noexcept { return *impl_; }
 

@@ -22,9 +22,20 @@ namespace {
 
 class Meter {
 public:
-  explicit Meter(const QueryBudget& budget)
+  // reservePerPair: seconds to set aside per frontier pair for turning the frontier into
+  // contacts, so that the answer, too, ends by the deadline (0: stop at the deadline itself).
+  Meter(const QueryBudget& budget, double reservePerPair)
       : limit_(budget.maxTests), deadline_(budget.deadline), now_(budget.now),
-        timed_(budget.deadline != QueryBudget::TimePoint::max()) {}
+        timed_(budget.deadline != QueryBudget::TimePoint::max()), reservePerPair_(reservePerPair) {
+    if (timed_ && reservePerPair_ > 0.0) start_ = now_();
+  }
+
+  // The traversal's current frontier size (pairs the answer will have to turn into contacts).
+  void setFrontier(std::size_t pairs) { frontier_ = pairs; }
+  // Exact model: triangle tests left until the query finishes, when finishing makes the answer
+  // unnecessary (0: unknown). The reserve is then the cheaper of answering the frontier and
+  // finishing at this query's average time per test so far.
+  void setRemainingTests(std::uint64_t tests) { remainingTests_ = tests; }
 
   bool take() {
     if (stopped_) return false;
@@ -35,7 +46,8 @@ public:
     }
     if (timed_) {
       if (batchLeft_ == 0) {
-        if (now_() >= deadline_) {
+        const QueryBudget::TimePoint now = now_();
+        if (now + reserve(now) >= deadline_) {
           stop_ = QueryStop::kDeadline;
           stopped_ = true;
           return false;
@@ -52,15 +64,85 @@ public:
   std::uint64_t used() const { return used_; }
 
 private:
+  QueryBudget::Clock::duration reserve(QueryBudget::TimePoint now) const {
+    if (reservePerPair_ <= 0.0) return QueryBudget::Clock::duration::zero();
+    double seconds = reservePerPair_ * static_cast<double>(frontier_);
+    if (remainingTests_ > 0 && used_ > 0) {
+      const double perTest = std::chrono::duration<double>(now - start_).count() / static_cast<double>(used_);
+      seconds = std::min(seconds, perTest * static_cast<double>(remainingTests_));
+    }
+    // Capped at an hour so the arithmetic on time points cannot overflow.
+    return std::chrono::duration_cast<QueryBudget::Clock::duration>(
+        std::chrono::duration<double>(std::clamp(seconds, 0.0, 3600.0)));
+  }
+
   std::uint64_t limit_;
   QueryBudget::TimePoint deadline_;
   QueryBudget::TimePoint (*now_)();
   bool timed_;
+  double reservePerPair_;
+  QueryBudget::TimePoint start_{};
+  std::size_t frontier_ = 0;
+  std::uint64_t remainingTests_ = 0;
   // The first batch starts without a clock read (budget.h).
   std::uint32_t batchLeft_ = kDeadlineBatch;
   std::uint64_t used_ = 0;
   bool stopped_ = false;
   QueryStop stop_ = QueryStop::kFinished;
+};
+
+// Deadline while the frontier is turned into contacts (QueryBudget::answerWithinDeadline): the
+// first batch of pairs is always answered, then the clock is read once per batch; past the
+// deadline the rest of the frontier -- its lowest-priority end: the traversal leaves the deepest
+// pairs' children first -- gets no contacts (unless none was found yet: next()). Also times the answer, to learn its cost per pair.
+inline constexpr std::uint32_t kAnswerBatch = 8;
+
+class AnswerClock {
+public:
+  // batch: pairs between clock reads, about a microsecond of work each -- kAnswerBatch sphere
+  // pairs (tens of ns to a few hundred each), or 1 contact-tree cell pair (each samples two
+  // cells' fields: microseconds). A clock read costs ~20-30 ns.
+  AnswerClock(const QueryBudget& budget, std::uint32_t batch)
+      : deadline_(budget.deadline), now_(budget.now),
+        timed_(budget.deadline != QueryBudget::TimePoint::max() && budget.answerWithinDeadline), batch_(batch),
+        batchLeft_(batch) {
+    if (timed_) start_ = now_();
+  }
+
+  bool timed() const { return timed_; }
+  // May the next pair be answered? Past the deadline only while the answer has no contact yet
+  // (`haveContact`), for at most kDeadlineBatch more pairs: a deep overlap whose first answered
+  // pairs happen to give nothing (contact-tree samples all outside) still reports a contact.
+  bool next(bool haveContact) {
+    if (cut_ && (haveContact || extra_ >= kDeadlineBatch)) return false;
+    if (cut_) {
+      ++extra_;
+    } else if (timed_) {
+      if (batchLeft_ == 0) {
+        if (now_() >= deadline_) {
+          cut_ = true;
+          return next(haveContact);
+        }
+        batchLeft_ = batch_;
+      }
+      --batchLeft_;
+    }
+    ++answered_;
+    return true;
+  }
+  std::uint64_t answered() const { return answered_; }
+  double secondsSinceStart() const { return std::chrono::duration<double>(now_() - start_).count(); }
+
+private:
+  QueryBudget::TimePoint deadline_;
+  QueryBudget::TimePoint (*now_)();
+  bool timed_;
+  std::uint32_t batch_;
+  std::uint32_t batchLeft_;
+  QueryBudget::TimePoint start_{};
+  std::uint64_t answered_ = 0;
+  std::uint32_t extra_ = 0;
+  bool cut_ = false;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -157,12 +239,26 @@ struct QueryScratch::Impl {
   std::vector<Contact> raw;
   std::vector<ContactPoint> sampled;
   std::vector<double> manifold;
+  // Seconds per frontier pair of turning a frontier into contacts, per model (index =
+  // ContactModel), learned from this scratch's deadline queries (QueryBudget::answerWithinDeadline).
+  // Starting values: medians measured on the deep benchmark poses (bench_narrowphase
+  // BM_NarrowPhase_Deadline, 2-core x86-64, 2026): they only matter until the first deadline query.
+  std::array<double, 5> answerSecondsPerPair{0.02e-6, 0.1e-6, 0.3e-6, 2.0e-6, 0.3e-6};
 };
 
 QueryScratch::QueryScratch() : impl_(std::make_unique<Impl>()) {}
 QueryScratch::~QueryScratch() = default;
 QueryScratch::QueryScratch(QueryScratch&&) noexcept = default;
 QueryScratch& QueryScratch::operator=(QueryScratch&&) noexcept = default;
+double QueryScratch::answerSecondsPerPair(ContactModel model) const noexcept {
+  return impl_->answerSecondsPerPair[static_cast<std::size_t>(model)];
+}
+void QueryScratch::setAnswerSecondsPerPair(ContactModel model, double seconds) {
+  if (!(seconds >= 0.0) || !std::isfinite(seconds)) {
+    throw Error(ErrorCode::kInvalidArgument, "answer seconds per pair must be finite and >= 0, got " + std::to_string(seconds));
+  }
+  impl_->answerSecondsPerPair[static_cast<std::size_t>(model)] = seconds;
+}
 
 struct CoherenceCache::Impl {
   const CollisionBody* a = nullptr;
@@ -247,7 +343,9 @@ public:
   // the status they came with (`assumeOverlap`).
   void retest(const std::vector<Pair>& pairs, bool assumeOverlap, std::vector<Pair>& front,
               std::vector<Pair>* separated) {
-    for (const Pair& p : pairs) {
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      const Pair& p = pairs[i];
+      meter_.setFrontier(front.size() + (pairs.size() - i));
       double pen = 0.0;
       const TestOutcome o = test(a_.center(p.a), a_.radius(p.a), centerB(p.b), b_.radius(p.b), pen);
       if (o == TestOutcome::kOverlap) {
@@ -271,10 +369,22 @@ public:
         if (SideA::index(x.a) != SideA::index(y.a)) return SideA::index(x.a) < SideA::index(y.a);
         return SideB::index(x.b) < SideB::index(y.b);
       });
+      if (directPairs_ > 0) {
+        // Exact model: tests left to finish, at most the frontier pairs' triangle pairs and at
+        // most all triangle pairs of the two meshes (the deduplicated total) -- a small mesh
+        // pair finishes sooner than its frontier can be answered from the spheres (Meter).
+        const std::uint64_t all = a_.triangleCount(a_.root()) * b_.triangleCount(b_.root());
+        std::uint64_t left = 0;
+        for (std::size_t i = 0; i < front.size() && left < all; ++i) {
+          left += a_.triangleCount(front[i].a) * b_.triangleCount(front[i].b);
+        }
+        meter_.setRemainingTests(std::min(left, all));
+      }
       next.clear();
       bool expanded = false;
       for (std::size_t i = 0; i < front.size(); ++i) {
         const Pair& p = front[i];
+        meter_.setFrontier(next.size() + (front.size() - i));
         const bool leafA = a_.isLeaf(p.a);
         const bool leafB = b_.isLeaf(p.b);
         if ((leafA && leafB) || a_.triangleCount(p.a) * b_.triangleCount(p.b) <= directPairs_) {
@@ -573,11 +683,12 @@ Vec3 differenceNormal(const Vec3& nA, const Vec3& nB, const Vec3& dosNormal) {
 // Contacts of the sphere models, one per frontier pair. Pairs proven apart (cfm: a separating
 // axis between their patches) give none.
 void sphereContacts(ContactModel model, const CollisionBody& bodyA, const CollisionBody& bodyB, const Pose& xfAFromB,
-                    const std::vector<SpherePair>& front, std::vector<Contact>& out) {
+                    const std::vector<SpherePair>& front, AnswerClock& clock, std::vector<Contact>& out) {
   const SphereTree& ta = bodyA.sphereTree();
   const SphereTree& tb = bodyB.sphereTree();
   const Eigen::Matrix3d rotAFromB = xfAFromB.rotation.toRotationMatrix();
   for (const SpherePair& p : front) {
+    if (!clock.next(!out.empty())) break;
     const Vec3 cA = ta.center(p.a);
     const Vec3 cB = xfAFromB.apply(tb.center(p.b));
     const double rA = ta.radius[p.a];
@@ -905,6 +1016,8 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
     std::size_t k = 0;
     const std::size_t n = s.trianglePairs.size();
     for (std::uint32_t i = 0; i < front.size() && complete; ++i) {
+      meter.setFrontier(front.size() - i);  // pairs the cfm fallback would answer if stopped now
+      meter.setRemainingTests(n - k);
       for (; k < n && s.trianglePairs[k].pair == i; ++k) {
         if (!meter.take()) {
           complete = false;
@@ -1001,6 +1114,14 @@ void fillFrontier(const std::vector<Pair>& front, const SideA& sa, const SideB& 
   }
 }
 
+// Updates the per-pair answer cost from a timed answer of at least 8 pairs
+// (exponential average: one slow answer, e.g. a cold cache, moves it by a quarter).
+void learnAnswerCost(const AnswerClock& answer, double& secondsPerPair) {
+  if (!answer.timed() || answer.answered() < 8) return;
+  const double measured = answer.secondsSinceStart() / static_cast<double>(answer.answered());
+  secondsPerPair = 0.75 * secondsPerPair + 0.25 * measured;
+}
+
 // Runs the traversal from the roots or from a cache's front. Returns true when finished.
 template <class SideA, class SideB, class Pair>
 bool traverse(const SideA& sa, const SideB& sb, const Pose& xfAFromB, Meter& meter, std::vector<Pair>& front,
@@ -1042,8 +1163,10 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
 
   QueryScratch::Impl& s = scratch.impl();
   const Pose xfAFromB = xfWorldFromA.inverse() * xfWorldFromB;
-  Meter meter(settings.budget);
+  double& answerCost = s.answerSecondsPerPair[static_cast<std::size_t>(model)];
+  Meter meter(settings.budget, settings.budget.answerWithinDeadline ? answerCost : 0.0);
   result.contacts.clear();
+  result.pairsAnswered = 0;
   result.triangleTests = 0;
   result.intersectingTriangles.clear();
   s.raw.clear();
@@ -1066,6 +1189,7 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
       const bool complete =
           exactContacts(a, b, xfAFromB, s.sphereFront, finished, meter, s, s.raw, result.triangleTests,
                         result.intersectingTriangles);
+      for (std::uint8_t done : s.pairDone) result.pairsAnswered += done;
       if (!complete) {
         // Frontier pairs that did not get their triangle tests answer from their spheres: as cfm
         // does when both bodies carry closest feature maps (no tests: the maps and patches are
@@ -1077,7 +1201,10 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
         }
         const ContactModel fallback =
             a.hasClosestFeatureMap() && b.hasClosestFeatureMap() ? ContactModel::kCfm : ContactModel::kDos;
-        sphereContacts(fallback, a, b, xfAFromB, s.sphereNext, s.raw);
+        AnswerClock answer(settings.budget, kAnswerBatch);
+        sphereContacts(fallback, a, b, xfAFromB, s.sphereNext, answer, s.raw);
+        learnAnswerCost(answer, answerCost);
+        result.pairsAnswered += answer.answered();
         finished = false;
         exactInterrupted = fallback == ContactModel::kCfm;
         // cfm drops pairs proven apart, as in the cfm model: then colliding means some contact.
@@ -1086,7 +1213,10 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
         result.colliding = !s.raw.empty();
       }
     } else {
-      sphereContacts(model, a, b, xfAFromB, s.sphereFront, s.raw);
+      AnswerClock answer(settings.budget, kAnswerBatch);
+      sphereContacts(model, a, b, xfAFromB, s.sphereFront, answer, s.raw);
+      learnAnswerCost(answer, answerCost);
+      result.pairsAnswered = answer.answered();
       // cfm drops pairs proven apart: colliding means some pair gave a contact.
       result.colliding = model == ContactModel::kCfm ? !s.raw.empty() : !s.sphereFront.empty();
     }
@@ -1108,7 +1238,9 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
     ContactSamplingSettings sampling = settings.contactSampling;
     sampling.maxDepth = kContactTreeLeafDepth;
     s.sampled.clear();
+    AnswerClock answer(settings.budget, 1);
     for (const CellPair& p : s.cellFront) {
+      if (!answer.next(!s.raw.empty())) break;
       // Field queries always go to the leaves: the budget buys traversal, and a coarse cell's
       // trilinear field is too smooth to say whether a sample penetrates (measured: a box on a
       // box then gets no contact at all from a 16-test traversal). O(depth) per sample.
@@ -1131,6 +1263,8 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
         s.raw.push_back(ct);
       }
     }
+    learnAnswerCost(answer, answerCost);
+    result.pairsAnswered = answer.answered();
     result.colliding = !s.raw.empty();
     if (c != nullptr) {
       c->a = &a;

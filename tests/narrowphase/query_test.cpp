@@ -305,6 +305,9 @@ TEST(NarrowPhaseBudget, DeadlineOverrunIsAtMostOneBatch) {
       QuerySettings s = settingsFor(model, kUnlimitedTests);
       s.budget.now = &tickClock;
       s.budget.deadline = QueryBudget::TimePoint(QueryBudget::Clock::duration(readsBefore));
+      // The traversal's own accounting: no reserve for the answer, no clock reads while answering
+      // (NarrowPhaseBudget.AnswerEndsByTheDeadline covers those).
+      s.budget.answerWithinDeadline = false;
       const QueryResult r = queryContacts(b.sphereA, poseA, b.sphereB, Pose{}, s);
       // Reads 0 .. readsBefore-1 see a time before the deadline and each grants one batch; the
       // first batch needs no read. The read that sees the deadline stops the query at once.
@@ -323,6 +326,76 @@ TEST(NarrowPhaseBudget, DeadlineOverrunIsAtMostOneBatch) {
   const QueryResult r = queryContacts(b.sphereA, poseA, b.sphereB, Pose{}, s);
   EXPECT_LE(r.tests, kDeadlineBatch);
   EXPECT_FALSE(r.finished);
+}
+
+TEST(NarrowPhaseBudget, AnswerEndsByTheDeadline) {
+  // The traversal stops at the deadline (no reserve for the answer: the estimate is pinned to
+  // 0), so the answer starts past it: it answers one batch of frontier pairs (8 sphere pairs or
+  // 1 cell pair), then reads the clock, sees the deadline and leaves the rest of the frontier
+  // unanswered -- unless no contact came yet, then up to kDeadlineBatch more pairs (budget.h). Before, the whole frontier was answered after the deadline
+  // (a cfm query with a 100 us deadline on two deep bunnies returned after 1.1 ms).
+  const Bodies& b = bodies();
+  Pose poseA;
+  poseA.translation = Vec3(0.3, 0.1, 1.2);  // deep overlap: frontiers of hundreds of pairs
+  for (ContactModel model : allContactModels()) {
+    gTicks = 0;
+    QueryScratch scratch;
+    scratch.setAnswerSecondsPerPair(model, 0.0);
+    QuerySettings s = settingsFor(model, kUnlimitedTests);
+    s.budget.now = &tickClock;
+    s.budget.deadline = QueryBudget::TimePoint(QueryBudget::Clock::duration(20));
+    QueryResult r;
+    queryContacts(b.sphereA, poseA, b.sphereB, Pose{}, s, scratch, r);
+    ASSERT_EQ(r.stop, QueryStop::kDeadline) << contactModelName(model);
+    ASSERT_GT(r.frontier.size(), kDeadlineBatch) << contactModelName(model);
+    EXPECT_GE(r.pairsAnswered, 1u) << contactModelName(model);
+    EXPECT_LE(r.pairsAnswered, 2 * kDeadlineBatch) << contactModelName(model);
+    EXPECT_LT(r.pairsAnswered, r.frontier.size()) << contactModelName(model);
+    EXPECT_FALSE(r.contacts.empty()) << contactModelName(model);
+
+    // The same query with the answer outside the deadline answers every frontier pair.
+    gTicks = 0;
+    s.budget.answerWithinDeadline = false;
+    queryContacts(b.sphereA, poseA, b.sphereB, Pose{}, s, scratch, r);
+    EXPECT_EQ(r.pairsAnswered, r.frontier.size()) << contactModelName(model);
+  }
+}
+
+TEST(NarrowPhaseBudget, TraversalStopsEarlyEnoughToAnswerItsFrontier) {
+  // Fake clock: one tick (1 ns) per read. With an answer cost of 1 ns per frontier pair the
+  // traversal must stop at the first batch boundary where "now + frontier size" reaches the
+  // deadline, so its frontier cannot exceed the deadline's tick count by more than one batch of
+  // tests can add (each test adds at most one pair). Without the reserve it runs to the deadline.
+  const Bodies& b = bodies();
+  Pose poseA;
+  poseA.translation = Vec3(0.3, 0.1, 1.2);
+  constexpr std::int64_t kDeadlineTicks = 100;
+  for (ContactModel model : allContactModels()) {
+    QuerySettings s = settingsFor(model, kUnlimitedTests);
+    s.budget.now = &tickClock;
+    s.budget.deadline = QueryBudget::TimePoint(QueryBudget::Clock::duration(kDeadlineTicks));
+    QueryScratch scratch;
+    scratch.setAnswerSecondsPerPair(model, 1e-9);
+    gTicks = 0;
+    QueryResult reserved;
+    queryContacts(b.sphereA, poseA, b.sphereB, Pose{}, s, scratch, reserved);
+    scratch.setAnswerSecondsPerPair(model, 0.0);
+    gTicks = 0;
+    QueryResult unreserved;
+    queryContacts(b.sphereA, poseA, b.sphereB, Pose{}, s, scratch, unreserved);
+    ASSERT_EQ(reserved.stop, QueryStop::kDeadline) << contactModelName(model);
+    EXPECT_LE(reserved.frontier.size(), static_cast<std::size_t>(kDeadlineTicks) + kDeadlineBatch)
+        << contactModelName(model);
+    EXPECT_LT(reserved.tests, unreserved.tests) << contactModelName(model);
+  }
+}
+
+TEST(NarrowPhaseBudget, AnswerCostMustBeFiniteAndNonNegative) {
+  QueryScratch scratch;
+  EXPECT_THROW(scratch.setAnswerSecondsPerPair(ContactModel::kCfm, -1.0), Error);
+  EXPECT_THROW(scratch.setAnswerSecondsPerPair(ContactModel::kCfm, std::nan("")), Error);
+  scratch.setAnswerSecondsPerPair(ContactModel::kCfm, 2e-7);
+  EXPECT_EQ(scratch.answerSecondsPerPair(ContactModel::kCfm), 2e-7);
 }
 
 double penetration(const SphereTree& ta, std::uint32_t a, const SphereTree& tb, std::uint32_t b, const Pose& xfAFromB) {
