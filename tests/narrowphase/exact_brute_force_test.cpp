@@ -35,19 +35,9 @@ std::vector<std::array<std::uint32_t, 2>> bruteForce(const TriangleMesh& a, cons
   return hits;
 }
 
-Pose randomPose(std::mt19937_64& rng, double spread) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Pose p;
-  p.rotation = Quat(u(rng), u(rng), u(rng), u(rng)).normalized();
-  p.translation = spread * Vec3(u(rng), u(rng), u(rng));
-  return p;
-}
-
 TEST(ExactModel, FindsTheSameIntersectingTrianglePairsAsBruteForce) {
   // The bunny (1,499 triangles, scaled to unit size) against an icosphere and a box.
-  TriangleMesh bunny = loadMesh(CLOD_SHARED_MESH_DIR "/bunny-1500.obj").mesh;
-  const Aabb box = bunny.bounds();
-  for (Vec3& v : bunny.vertices) v = (v - box.center()) / box.diagonal();
+  const TriangleMesh bunny = test::loadUnitMesh("bunny-1500.obj");
   // The exact model needs neither closest feature maps nor contact trees.
   const CollisionBody bunnyBody = test::makeTestBody(bunny, 3, false, false);
   const CollisionBody sphere = test::makeTestBody(makeIcosphere(0.3, 3), 2, false, false);
@@ -57,8 +47,8 @@ TEST(ExactModel, FindsTheSameIntersectingTrianglePairsAsBruteForce) {
   int colliding = 0;
   for (int k = 0; k < poses; ++k) {
     const CollisionBody& other = (k % 2) ? sphere : cube;
-    const Pose poseA = randomPose(rng, 0.1);
-    const Pose poseB = randomPose(rng, 0.4);
+    const Pose poseA = test::randomPose(rng, 0.1);
+    const Pose poseB = test::randomPose(rng, 0.4);
     QuerySettings settings;
     settings.model = ContactModel::kExact;
     const QueryResult r = queryContacts(bunnyBody, poseA, other, poseB, settings);

@@ -2,12 +2,14 @@
 // Bodies baked in-process for the narrow-phase tests (small trees, to keep the tests fast).
 
 #include <cstdlib>
+#include <random>
 #include <string>
 
 #include "clod/bake.h"
 #include "clod/closest_feature_map.h"
 #include "clod/collision_body.h"
 #include "clod/contact_tree_builder.h"
+#include "clod/mesh_io.h"
 #include "clod/proximity.h"
 #include "support/test_scale.h"
 
@@ -40,6 +42,25 @@ inline CollisionBody makeTestBody(const TriangleMesh& mesh, std::uint32_t depth,
     body.setContactTree(buildContactTree(distance, ct));
   }
   return body;
+}
+
+/// A shared test mesh (../shared/data/meshes/NAME), centred and scaled to unit bounding-box
+/// diagonal, so tolerances in units of the diagonal read as plain numbers.
+inline TriangleMesh loadUnitMesh(const std::string& name) {
+  TriangleMesh mesh = loadMesh(std::string(CLOD_SHARED_MESH_DIR) + "/" + name).mesh;
+  const Aabb box = mesh.bounds();
+  for (Vec3& v : mesh.vertices) v = (v - box.center()) / box.diagonal();
+  return mesh;
+}
+
+/// A random rotation (a normalised quaternion of uniform components: not uniform over the
+/// rotations, but it reaches every orientation) and a translation in [-spread, spread]^3.
+inline Pose randomPose(std::mt19937_64& rng, double spread) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Pose p;
+  p.rotation = Quat(u(rng), u(rng), u(rng), u(rng)).normalized();
+  p.translation = spread * Vec3(u(rng), u(rng), u(rng));
+  return p;
 }
 
 }  // namespace clod::test

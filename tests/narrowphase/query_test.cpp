@@ -254,14 +254,6 @@ TEST(NarrowPhaseSpheres, SeparatedSpheresDoNotCollide) {
   }
 }
 
-Pose randomPose(std::mt19937_64& rng, double spread) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Pose p;
-  p.rotation = Quat(u(rng), u(rng), u(rng), u(rng)).normalized();
-  p.translation = spread * Vec3(u(rng), u(rng), u(rng));
-  return p;
-}
-
 TEST(NarrowPhaseBudget, TestCountIsNeverExceeded) {
   const Bodies& b = bodies();
   std::mt19937_64 rng(11);
@@ -270,8 +262,8 @@ TEST(NarrowPhaseBudget, TestCountIsNeverExceeded) {
   QueryScratch scratch;
   QueryResult r;
   for (int i = 0; i < poses; ++i) {
-    const Pose poseA = randomPose(rng, 1.5);
-    const Pose poseB = randomPose(rng, 0.5);
+    const Pose poseA = test::randomPose(rng, 1.5);
+    const Pose poseB = test::randomPose(rng, 0.5);
     const CollisionBody& a = (i % 2) ? b.cubeA : b.sphereA;
     for (ContactModel model : allContactModels()) {
       QuerySettings s = settingsFor(model, budget(rng));

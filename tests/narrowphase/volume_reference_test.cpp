@@ -10,7 +10,6 @@
 #include <random>
 #include <vector>
 
-#include "clod/mesh_io.h"
 #include "clod/primitives.h"
 #include "clod/query.h"
 #include "narrowphase_test_support.h"
@@ -22,14 +21,6 @@ namespace {
 constexpr double kRadiansToDegrees = 180.0 / 3.14159265358979323846;
 
 double angleDegrees(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)) * kRadiansToDegrees; }
-
-Pose randomPose(std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Pose p;
-  p.rotation = Quat(u(rng), u(rng), u(rng), u(rng)).normalized();
-  p.translation = Vec3(u(rng), u(rng), u(rng));
-  return p;
-}
 
 TEST(VolumeReference, MatchesAnAnalyticBoxOnBoxOverlap) {
   // A: half extents (1, 1, 1). B: half extents (0.5, 0.4, 0.3), centred above A's top face so
@@ -45,7 +36,7 @@ TEST(VolumeReference, MatchesAnAnalyticBoxOnBoxOverlap) {
   std::mt19937_64 rng(17);
   const int trials = test::sanitizerRun() ? 1 : 3;
   for (int trial = 0; trial < trials; ++trial) {
-    const Pose world = randomPose(rng);
+    const Pose world = test::randomPose(rng, 1.0);
     Pose offset;
     offset.translation = Vec3(0.2, -0.1, 1.0 + 0.3 - d);
     constexpr double kLeafRadius = 1e-3;
@@ -100,9 +91,7 @@ double touchingDistance(const CollisionBody& body, const Quat& rotation, const V
 TEST(VolumeReference, ExactModelNormalFollowsTheVolumeGradientOnTheBunny) {
   // bunny-1500 against itself, scaled to unit diagonal: random orientation and direction, moved
   // to touching and then 0.005 deeper (the accuracy harness's poses).
-  TriangleMesh bunny = loadMesh(CLOD_SHARED_MESH_DIR "/bunny-1500.obj").mesh;
-  const Aabb box = bunny.bounds();
-  for (Vec3& v : bunny.vertices) v = (v - box.center()) / box.diagonal();
+  const TriangleMesh bunny = test::loadUnitMesh("bunny-1500.obj");
   const CollisionBody body = test::makeTestBody(bunny, 3, false, false);
   const MeshDistance distance(bunny);
   std::mt19937_64 rng(2024);
