@@ -8,7 +8,7 @@
 //
 // Usage (all flags optional):
 //   world_compare [--scene FILE] [--cache DIR] [--steps N] [--models dos,cfm,contact-tree,exact]
-//                 [--budgets 1024,4096,16384,0] [--bullet gimpact,hull|none]
+//                 [--budgets 1024,4096,16384,0] [--budgets-us 1000,3000] (--budgets none: time budgets only) [--bullet gimpact,hull|none]
 //                 [--bullet-substeps 1,clod] [--bullet-steps N] [--bullet-iterations N]
 //                 [--row-seconds S] [--breakdown 1] [--frames-csv FILE] [--frontier-cost N]
 //                 [--min-substep-iterations N]
@@ -80,6 +80,7 @@ struct Options {
   std::uint32_t steps = 0;  // 0 = the scene's
   std::vector<std::string> models = {"dos", "cfm", "contact-tree", "exact"};
   std::vector<std::uint64_t> budgets = {1024, 4096, 16384, 0};
+  std::vector<double> budgetsMicros;  // --budgets-us: rows with a narrow-phase time budget instead
   std::vector<std::string> bullet = {"gimpact", "hull"};
   std::vector<std::uint32_t> bulletSubsteps = {1, 0};  // 0 = "clod"
   std::uint32_t bulletSteps = 0;  // 0 = same as clod
@@ -136,7 +137,16 @@ Options parseOptions(int argc, char** argv) {
       for (const std::string& m : o.models) clod::parseContactModel(m);  // throws kInvalidArgument
     } else if (flag == "--budgets") {
       o.budgets.clear();
-      for (const std::string& b : splitList(value)) o.budgets.push_back(parseCount(flag, b));
+      if (value != "none")
+        for (const std::string& b : splitList(value)) o.budgets.push_back(parseCount(flag, b));
+    } else if (flag == "--budgets-us") {
+      o.budgetsMicros.clear();
+      for (const std::string& b : splitList(value)) {
+        char* end = nullptr;
+        const double us = std::strtod(b.c_str(), &end);
+        if (b.empty() || *end != '\0' || !(us > 0.0 && us <= 1e9)) throw UsageError{"--budgets-us: expected microseconds in (0, 1e9], got '" + b + "'"};
+        o.budgetsMicros.push_back(us);
+      }
     } else if (flag == "--bullet") {
       o.bullet = value == "none" ? std::vector<std::string>{} : splitList(value);
       for (const std::string& b : o.bullet)
@@ -270,18 +280,21 @@ void progress(const std::string& label, std::uint32_t step, std::uint32_t steps)
 // each budget row then starts from a fresh World with the template's bodies (descs hold the
 // initial state and share the baked shapes), so the contact trees are built once per run.
 Row runClod(const clod::World& tmpl, const clod::SceneDescription& scene, clod::ContactModel model,
-            std::uint64_t budget, std::uint32_t steps, double rowSeconds, const Bin& bin, const Options& o) {
+            std::uint64_t budget, double budgetMicros, std::uint32_t steps, double rowSeconds, const Bin& bin,
+            const Options& o) {
   clod::WorldSettings ws = scene.world;
   if (o.frontierCost) ws.frontierPairCost = *o.frontierCost;
   if (o.minSubstepIterations) ws.minSubstepIterations = *o.minSubstepIterations;
   ws.model = model;
   ws.budgetTests = budget;
+  ws.budgetMicros = budgetMicros;
   clod::World world(ws);
   for (BodyId i = 0; i < tmpl.bodyCount(); ++i) world.addBody(tmpl.desc(i));
   Row row;
   row.engine = "clod";
   row.model = std::string(clod::contactModelName(model));
-  row.budget = budget ? std::to_string(budget) : "unlimited";
+  row.budget = budgetMicros > 0.0 ? std::to_string(std::llround(budgetMicros)) + " us"
+                                  : budget ? std::to_string(budget) : "unlimited";
   row.steps = steps;
   const std::string label = "clod " + row.model + " " + row.budget;
   for (std::uint32_t s = 1; s <= steps; ++s) {
@@ -515,6 +528,16 @@ std::string withCommas(std::uint64_t v) {
   return out;
 }
 
+// The narrow phase's wall time per frame (StepReport::narrowPhaseSeconds): for time-budget rows,
+// against the budget.
+void printNarrowPhaseTimes(const Row& r) {
+  std::vector<double> narrow;
+  for (const Frame& f : r.frames) narrow.push_back(1e3 * f.narrow);
+  std::cout << "narrow phase per frame, " << r.model << " " << r.budget << ": median " << fmt(percentile(narrow, 0.5), 3)
+            << " ms, p99 " << fmt(percentile(narrow, 0.99), 3) << " ms, max " << fmt(percentile(narrow, 1.0), 3)
+            << " ms\n" << std::flush;
+}
+
 void printTable(const std::vector<Row>& rows) {
   std::cout << "| engine | model / shape | budget (tests/frame) | steps | substeps/frame (median) | median ms | p99 ms"
                 " | p99/median | max ms | CPU median ms | CPU p99 ms | CPU p99/median | max tests/frame | max spent/frame | left bounds | outside bin at end"
@@ -585,8 +608,14 @@ int run(const Options& o) {
               << fmt(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1) << " s ("
               << rep.shapesBaked << " shapes baked, " << rep.shapesFromCache << " from cache)\n";
     for (std::uint64_t budget : o.budgets) {
-      rows.push_back(runClod(tmpl, s, s.world.model, budget, steps, o.rowSeconds, bin, o));
+      rows.push_back(runClod(tmpl, s, s.world.model, budget, 0.0, steps, o.rowSeconds, bin, o));
       printTable({rows.back()});
+      printNarrowPhaseTimes(rows.back());
+    }
+    for (double us : o.budgetsMicros) {
+      rows.push_back(runClod(tmpl, s, s.world.model, 0, us, steps, o.rowSeconds, bin, o));
+      printTable({rows.back()});
+      printNarrowPhaseTimes(rows.back());
     }
     if (!any) any.emplace(std::move(tmpl));
   }
@@ -640,7 +669,7 @@ int main(int argc, char** argv) {
   } catch (const UsageError& e) {
     if (!e.message.empty()) std::cerr << "world_compare: " << e.message << '\n';
     std::cerr << "usage: world_compare [--scene FILE] [--cache DIR] [--steps N] [--models dos,cfm,contact-tree,exact|none]\n"
-                 "                     [--budgets 1024,4096,16384,unlimited] [--bullet gimpact,hull|none]\n"
+                 "                     [--budgets 1024,4096,16384,unlimited] [--budgets-us 1000,3000] [--bullet gimpact,hull|none]\n"
                  "                     [--bullet-substeps 1,clod] [--bullet-steps N] [--bullet-iterations N]\n"
                  "                     [--row-seconds S] [--breakdown 1] [--frames-csv FILE] [--frontier-cost N]\n"
                  "                     [--min-substep-iterations N]\n";

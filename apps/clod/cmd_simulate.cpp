@@ -1,4 +1,4 @@
-// clod simulate SCENE.json -o OUTDIR [--contact-model M] [--budget N] [--progress]: runs a JSON
+// clod simulate SCENE.json -o OUTDIR [--contact-model M] [--budget N] [--budget-us T] [--progress]: runs a JSON
 // scene (scene.h) and writes, atomically, OUTDIR/trajectory.csv
 // (step,time,body,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz; step 0 is the initial state),
 // OUTDIR/contacts.csv (step,body_a,body_b,px,py,pz,nx,ny,nz,depth,level; the contacts the solver
@@ -36,6 +36,7 @@ struct SimulateOptions {
   std::string outDir;
   std::string model;
   std::optional<std::uint64_t> budget;
+  std::optional<double> budgetMicros;
   bool progress = false;
   bool gltf = false;
   std::string gltfLayers = "spheres,cfm,ctree";
@@ -73,6 +74,12 @@ int runSimulate(const SimulateOptions& o) {
   SceneDescription scene = loadScene(o.scene);
   if (!o.model.empty()) scene.world.model = parseContactModel(o.model);
   if (o.budget) scene.world.budgetTests = *o.budget;
+  if (o.budgetMicros) {
+    if (!(*o.budgetMicros >= 0.0 && *o.budgetMicros <= 1e9)) {
+      throw Error(ErrorCode::kInvalidArgument, "--budget-us must be a number in [0, 1e9]");
+    }
+    scene.world.budgetMicros = *o.budgetMicros;
+  }
   const std::filesystem::path out(o.outDir);
   std::error_code ec;
   std::filesystem::create_directories(out, ec);
@@ -142,6 +149,7 @@ int runSimulate(const SimulateOptions& o) {
                             {"dt", scene.dt},
                             {"contact_model", std::string(contactModelName(scene.world.model))},
                             {"budget", scene.world.budgetTests},
+                            {"budget_us", scene.world.budgetMicros},
                             {"energy", energy},
                             {"budget_spent", spent},
                             {"step_seconds", stepSeconds},
@@ -182,6 +190,8 @@ const CommandRegistration kRegistration("simulate", [](CLI::App& app) {
   sub->add_option("-o,--output", options->outDir, "Output directory")->required();
   sub->add_option("--contact-model", options->model, "Override: dos, average, cfm, contact-tree, exact");
   sub->add_option("--budget", options->budget, "Override: tests per frame (0 = unlimited)");
+  sub->add_option("--budget-us", options->budgetMicros,
+                  "Override: narrow-phase microseconds per frame (0 = unlimited; with --budget both apply)");
   sub->add_flag("--progress", options->progress, "Always show the progress bar on stderr");
   CLI::Option* gltf =
       sub->add_flag("--gltf", options->gltf, "Also write scene.glb (meshes + animation) and layers.json (debug layers)");

@@ -5,7 +5,8 @@
 //
 // Top-level keys (all optional except bodies): "gravity" [x,y,z] (default [0,0,-9.81]),
 // "dt" (s, default 1/60), "steps" or "duration" (s; default 120 steps), "contact_model"
-// (contact.h names, default "cfm"), "budget" (tests per frame, 0 = unlimited), "max_contacts",
+// (contact.h names, default "cfm"), "budget" (tests per frame, 0 = unlimited), "budget_us"
+// (narrow-phase microseconds per frame, WorldSettings::budgetMicros, 0 = unlimited), "max_contacts",
 // "min_substeps" (WorldSettings::minSubsteps, default 1; tall stacks need ~8),
 // "min_substep_iterations" (WorldSettings::minSubstepIterations, 0..20, default 4),
 // "frontier_pair_cost" (WorldSettings::frontierPairCost, 0..1024, default 2),

@@ -59,6 +59,7 @@
 #include <vector>
 
 #include "clod/broadphase.h"
+#include "clod/budget.h"
 #include "clod/contact.h"
 #include "clod/rigid_body.h"
 
@@ -74,6 +75,20 @@ struct WorldSettings {
   /// substeps together; 0 = unlimited. A step never spends more. Each substep gets an equal
   /// share of what the step has left (rounded up); what it does not spend rolls over.
   std::uint64_t budgetTests = 0;
+  /// Narrow-phase wall-clock time per step in microseconds, for all pairs and substeps together;
+  /// 0 = no time limit (finite, >= 0). Each step converts it to budget units at the narrow
+  /// phase's measured time per unit (an exponential average over the previous time-budgeted
+  /// steps, StepReport::testsBudget shows the result) and divides those like budgetTests (with
+  /// both set, the smaller applies). As a backstop each substep also has an equal share of the
+  /// time the step has left: pairs reached after it is gone keep their contacts (skipped, ranked
+  /// first next substep), so a step's narrow phase ends within budgetMicros plus the one query
+  /// running when it ran out (a query bounded by its test share). Per-query deadlines were
+  /// tried first and lost bodies in the 200-body bin: each query's fixed cost is a large part of
+  /// a share of a few microseconds, so the pairs late in the order starved (docs/dynamics.md).
+  double budgetMicros = 0.0;
+  /// The clock budgetMicros is measured with (also passed to the queries); replaceable so tests
+  /// can count reads instead of timing. Must be non-null.
+  QueryBudget::TimePoint (*clock)() = &QueryBudget::Clock::now;
   /// Budget units charged per pair of the answer frontier a query turns into contacts (0..1024),
   /// for the models that do real work per frontier pair besides the tests: the contact tree
   /// samples each cell pair, cfm looks up both closest feature maps and runs a separating-axis
@@ -140,10 +155,16 @@ struct StepReport {
   std::uint32_t substeps = 0;
   std::uint64_t candidatePairs = 0;  ///< broad-phase pairs, summed over substeps
   std::uint64_t testsSpent = 0;      ///< narrow-phase tests, all pairs and substeps
-  std::uint64_t testsBudget = 0;     ///< WorldSettings::budgetTests (0 = unlimited); testsSpent <= it
+  /// WorldSettings::budgetTests, or what budgetMicros converted to (the smaller when both are
+  /// set; 0 = unlimited); budgetSpent <= it.
+  std::uint64_t testsBudget = 0;
   /// What the budget counted: testsSpent + WorldSettings::frontierPairCost x the frontier pairs of
   /// the charged models' queries (= testsSpent for dos and average); <= testsBudget when limited.
   std::uint64_t budgetSpent = 0;
+  double timeBudgetMicros = 0.0;     ///< WorldSettings::budgetMicros (0 = no time limit)
+  /// Narrow-phase time the time budget counted (WorldSettings::clock, µs, all substeps); 0 when
+  /// there is no time limit.
+  double timeSpentMicros = 0.0;
   std::uint64_t pairsSkipped = 0;    ///< pair queries skipped for lack of budget, summed
   std::uint64_t pairsInterrupted = 0;///< queries that stopped before the leaves, summed
   std::uint32_t solverIterations = 0;///< velocity iterations used, summed over substeps

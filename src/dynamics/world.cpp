@@ -128,6 +128,11 @@ struct World::Impl {
   std::vector<Vec3> savedV, savedW, dV, dW;
   std::map<std::uint64_t, PairReport> pairReports;
   std::uint32_t velocityIterationsNow = 20;
+  // Narrow-phase microseconds per budget unit (test or charged frontier pair), measured with
+  // WorldSettings::clock over the time-budgeted steps (exponential average); converts
+  // WorldSettings::budgetMicros to units. Starts at 0.5: the 200-body bin's cfm and exact rows
+  // at 1,024 tests took 0.54 / 0.77 ms of narrow phase per frame (docs/benchmarks/world.md).
+  double microsPerUnit = 0.5;
   std::vector<double> stepTravel;
 
   void validateSettings() const {
@@ -143,11 +148,15 @@ struct World::Impl {
     if (s.maxSubsteps == 0) bad("maxSubsteps must be >= 1");
     if (s.minSubsteps == 0 || s.minSubsteps > s.maxSubsteps) bad("minSubsteps must be in [1, maxSubsteps]");
     if (s.frontierPairCost > 1024) bad("frontierPairCost must be in [0, 1024]");
+    if (!(s.budgetMicros >= 0.0 && std::isfinite(s.budgetMicros))) bad("budgetMicros must be >= 0 and finite");
+    if (s.clock == nullptr) bad("clock must not be null");
   }
 
   // limited == false: unlimited budget; else at most `allowance` budget units this substep (0:
   // none); `nominal` = ceil(budget / substeps), a substep's even share of the step.
-  void substep(double h, bool limited, std::uint64_t allowance, std::uint64_t nominal);
+  // timeAllowance: narrow-phase seconds this substep may take (WorldSettings::budgetMicros);
+  // negative = no time limit.
+  void substep(double h, bool limited, std::uint64_t allowance, std::uint64_t nominal, double timeAllowance);
   void solve(double h);
   void persistContacts(PairState& p, const Body& a, const Body& b, double diag);
   double kineticEnergyOfDynamicBodies() const;
@@ -209,7 +218,8 @@ void World::Impl::checkFinite() const {
   }
 }
 
-void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::uint64_t nominal) {
+void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::uint64_t nominal,
+                          double timeAllowance) {
   const WorldSettings& s = settings;
   using Clock = std::chrono::steady_clock;
   auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
@@ -265,20 +275,29 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
   qs.maxLevel = s.maxLevel;
   report.broadPhaseSeconds += since(tBroad);
   const auto t0 = Clock::now();
+  // Time budget (WorldSettings::budgetMicros): the step converted it to budget units; as a
+  // backstop, no query starts after this substep's share of the time is gone.
+  const bool timed = timeAllowance >= 0.0;
+  const QueryBudget::TimePoint tTimed = timed ? s.clock() : QueryBudget::TimePoint{};
+  const QueryBudget::TimePoint substepDeadline =
+      timed ? tTimed + std::chrono::duration_cast<QueryBudget::Clock::duration>(
+                           std::chrono::duration<double>(std::min(timeAllowance, 3600.0)))
+            : QueryBudget::TimePoint::max();
+  bool timeUp = false;
   for (auto& [p, ids] : order) {
     Body& a = bodies[ids[0]];
     Body& bb = bodies[ids[1]];
     PairReport& pr = pairReports[pairKey(ids[0], ids[1])];
     pr.a = ids[0];
     pr.b = ids[1];
+    // A skipped pair keeps its contacts and is ranked first next substep (stale).
+    auto skip = [&] {
+      pr.skipped = true;
+      ++report.pairsSkipped;
+      ++p->stale;
+      --left;
+    };
     if (limited) {
-      // A skipped pair keeps its contacts and is ranked first next substep (stale).
-      auto skip = [&] {
-        pr.skipped = true;
-        ++report.pairsSkipped;
-        ++p->stale;
-        --left;
-      };
       if (remaining == 0) {
         skip();
         continue;
@@ -308,6 +327,15 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     } else {
       qs.budget = QueryBudget::unlimited();
     }
+    if (timed) {
+      // Once the time is gone every remaining pair is skipped without reading the clock again.
+      const QueryBudget::TimePoint now = timeUp ? substepDeadline : s.clock();
+      if (now >= substepDeadline) {
+        timeUp = true;
+        skip();
+        continue;
+      }
+    }
     --left;
     queryContacts(*a.desc.shape, a.pose(), *bb.desc.shape, bb.pose(), qs, scratch, result, &p->cache);
     const std::uint64_t cost = result.tests + perCell * result.frontier.size();
@@ -333,6 +361,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     }
   }
   report.narrowPhaseSeconds += since(t0);
+  if (timed) report.timeSpentMicros += std::chrono::duration<double, std::micro>(s.clock() - tTimed).count();
   const auto tPrepare = Clock::now();
 
   // The solver walks the pairs in a fixed order (by body ids), not in the budget's priority
@@ -734,17 +763,36 @@ const StepReport& World::step(double dt) {
     m.velocityIterationsNow = std::uint32_t(std::min<std::uint64_t>(
         m.settings.velocityIterations, std::max<std::uint64_t>(m.settings.minSubstepIterations, (perStep + n - 1) / n)));
   }
-  m.report.testsBudget = m.settings.budgetTests;
+  // A time budget becomes budget units at the narrow phase's measured time per unit (an
+  // exponential average over the previous steps), so it is divided exactly as a test budget is
+  // (per-query deadlines instead starved the pairs late in the order: each query's fixed cost --
+  // its first batch of tests, the manifold -- is a large part of a few-microsecond share).
+  std::uint64_t budget = m.settings.budgetTests;
+  const bool timedStep = m.settings.budgetMicros > 0.0;
+  if (timedStep) {
+    const double units = std::max(1.0, std::floor(m.settings.budgetMicros / m.microsPerUnit));
+    const std::uint64_t fromTime = units >= 1e15 ? std::uint64_t(1e15) : std::uint64_t(units);
+    budget = budget == 0 ? fromTime : std::min(budget, fromTime);
+  }
+  m.report.testsBudget = budget;
   const double h = dt / n;
   // The budget is per step: each substep may spend an equal share of what the step has left,
   // rounded up (so a substep with anything left gets at least one test), and what a substep
-  // does not spend rolls over to the next. The step never spends more than budgetTests.
-  const bool limited = m.settings.budgetTests != 0;
+  // does not spend rolls over to the next. The step never spends more than `budget`.
+  const bool limited = budget != 0;
+  m.report.timeBudgetMicros = m.settings.budgetMicros;
   for (std::uint32_t i = 0; i < n; ++i) {
-    const std::uint64_t left = limited ? m.settings.budgetTests - std::min(m.settings.budgetTests, m.report.budgetSpent) : 0;
+    const std::uint64_t left = limited ? budget - std::min(budget, m.report.budgetSpent) : 0;
     const std::uint64_t substepsLeft = n - i;
-    m.substep(h, limited, (left + substepsLeft - 1) / substepsLeft, (m.settings.budgetTests + n - 1) / n);
+    // The time budget's backstop likewise: an equal share of what the step has left.
+    const double timeLeft = std::max(0.0, m.settings.budgetMicros - m.report.timeSpentMicros) * 1e-6;
+    const double timeAllowance = timedStep ? timeLeft / static_cast<double>(substepsLeft) : -1.0;
+    m.substep(h, limited, (left + substepsLeft - 1) / substepsLeft, (budget + n - 1) / n, timeAllowance);
     m.checkFinite();
+  }
+  if (timedStep && m.report.budgetSpent > 0) {
+    const double measured = m.report.timeSpentMicros / static_cast<double>(m.report.budgetSpent);
+    m.microsPerUnit = 0.75 * m.microsPerUnit + 0.25 * std::max(measured, 1e-6);
   }
   for (auto& [key, pr] : m.pairReports) {
     auto it = m.pairs.find(key);

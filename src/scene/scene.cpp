@@ -149,7 +149,7 @@ SceneDescription parseScene(std::string_view text, const std::filesystem::path& 
   } catch (const Json::parse_error& e) {
     throw Error(ErrorCode::kSceneError, fileName + ": not valid JSON: " + e.what());
   }
-  r.object(j, "", {"gravity", "dt", "steps", "duration", "contact_model", "budget", "max_contacts", "min_substeps",
+  r.object(j, "", {"gravity", "dt", "steps", "duration", "contact_model", "budget", "budget_us", "max_contacts", "min_substeps",
                   "min_substep_iterations", "frontier_pair_cost", "bounds", "bodies"});
   SceneDescription s;
   if (j.contains("gravity")) s.world.gravity = r.vec<3>(j["gravity"], "gravity");
@@ -171,6 +171,10 @@ SceneDescription parseScene(std::string_view text, const std::filesystem::path& 
     }
   }
   if (j.contains("budget")) s.world.budgetTests = r.count(j["budget"], "budget", 0, std::uint64_t(1) << 40);
+  if (j.contains("budget_us")) {
+    s.world.budgetMicros = r.nonNegative(j["budget_us"], "budget_us");
+    if (s.world.budgetMicros > 1e9) r.fail("budget_us", "must be at most 1e9 (microseconds per frame)");
+  }
   if (j.contains("max_contacts")) s.world.maxContacts = std::uint32_t(r.count(j["max_contacts"], "max_contacts", 1, 1024));
   if (j.contains("min_substeps"))
     s.world.minSubsteps = std::uint32_t(r.count(j["min_substeps"], "min_substeps", 1, s.world.maxSubsteps));

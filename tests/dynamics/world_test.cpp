@@ -5,7 +5,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <chrono>
+#include <limits>
 #include <memory>
+#include <set>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -335,6 +338,73 @@ TEST(World, BudgetBoundsTheTestsOfEveryFrame) {
     interrupted += r.pairsInterrupted + r.pairsSkipped;
   }
   EXPECT_GT(interrupted, 0u) << "the budget never bit: the test would prove nothing";
+}
+
+// A fake clock for the time budget: one microsecond per read, so time is counted in clock reads.
+std::int64_t gMicroTicks = 0;
+QueryBudget::TimePoint microClock() {
+  return QueryBudget::TimePoint(std::chrono::duration_cast<QueryBudget::Clock::duration>(std::chrono::microseconds(gMicroTicks++)));
+}
+
+TEST(World, TimeBudgetBoundsTheNarrowPhaseAndServesEveryPairInTurn) {
+  // Nine boxes resting on a slab, 0.2 apart: nine box-ground pairs every substep. With the fake
+  // clock every clock read costs 1 us. The world reads it once when a substep's narrow phase
+  // starts, once before each pair's query (the backstop: no query starts after the substep's
+  // share of the time is gone) and once at the end; the queries themselves get test budgets
+  // (the time converted to units), not deadlines, and do not read it. So 5 us serve at most 4
+  // of the 9 pairs per substep and the rest wait.
+  const auto slab = bakeShape(makeBox(Vec3(3.0, 3.0, 0.25)));
+  auto makeWorld = [&](double budgetMicros) {
+    WorldSettings ws;
+    ws.budgetMicros = budgetMicros;
+    ws.clock = &microClock;
+    auto world = std::make_unique<World>(ws);
+    addStaticGround(*world, slab, "ground");
+    for (int i = 0; i < 9; ++i) {
+      RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
+      box.position = Vec3(-1.2 + 1.2 * (i % 3), -1.2 + 1.2 * (i / 3), 0.75);
+      world->addBody(box);
+    }
+    return world;
+  };
+  constexpr double kBudget = 5.0;
+  auto world = makeWorld(kBudget);
+  std::set<std::pair<BodyId, BodyId>> served;
+  std::uint64_t skipped = 0;
+  for (int step = 0; step < 30; ++step) {
+    gMicroTicks = 0;
+    const StepReport& r = world->step(1.0 / 60.0);
+    EXPECT_EQ(r.timeBudgetMicros, kBudget);
+    EXPECT_GE(r.testsBudget, 1u);  // the time converted to budget units
+    // Each substep ends at most one read (its closing one) past its share of the time.
+    EXPECT_LE(r.timeSpentMicros, kBudget + r.substeps) << "step " << step;
+    EXPECT_LE(r.budgetSpent, r.testsBudget) << "step " << step;
+    skipped += r.pairsSkipped;
+    for (const PairReport& p : r.pairs)
+      if (!p.skipped) served.insert({p.a, p.b});
+  }
+  EXPECT_GT(skipped, 0u) << "the time budget never bit: the test would prove nothing";
+  // Skipped pairs are ranked first next time (round robin): every box-ground pair got queried.
+  for (BodyId box = 1; box <= 9; ++box) EXPECT_TRUE(served.count({0, box})) << "box " << box << " never served";
+
+  // Without a time budget nothing is skipped, and the clock is not read for it.
+  auto unlimited = makeWorld(0.0);
+  gMicroTicks = 0;
+  const StepReport& r = unlimited->step(1.0 / 60.0);
+  EXPECT_EQ(r.pairsSkipped, 0u);
+  EXPECT_EQ(r.timeSpentMicros, 0.0);
+  EXPECT_EQ(gMicroTicks, 0);
+}
+
+TEST(World, TimeBudgetMustBeFiniteAndNonNegative) {
+  WorldSettings ws;
+  ws.budgetMicros = -1.0;
+  EXPECT_THROW(World{ws}, Error);
+  ws.budgetMicros = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(World{ws}, Error);
+  ws.budgetMicros = 0.0;
+  ws.clock = nullptr;
+  EXPECT_THROW(World{ws}, Error);
 }
 
 // The contact tree samples every frontier cell pair of its answer, tested this query or kept from

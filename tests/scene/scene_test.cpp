@@ -44,6 +44,8 @@ TEST(SceneParse, OutOfRangeAndConflictingValuesAreErrors) {
   EXPECT_NE(sceneError(R"({"bodies": [{"box": [1,1,1], "orientation": [0,0,0,0]}]})").find("bodies[0].orientation"),
             std::string::npos);
   EXPECT_NE(sceneError(R"({"bodies": [], "frontier_pair_cost": 2000})").find("frontier_pair_cost"), std::string::npos);
+  EXPECT_NE(sceneError(R"({"bodies": [], "budget_us": -5})").find("budget_us: expected a number >= 0"), std::string::npos);
+  EXPECT_NE(sceneError(R"({"bodies": [], "budget_us": "fast"})").find("budget_us"), std::string::npos);
   EXPECT_NE(sceneError(R"({"bodies": [], "min_substep_iterations": 21})").find("min_substep_iterations"),
             std::string::npos);
   EXPECT_NE(sceneError("{not json").find("not valid JSON"), std::string::npos);
@@ -52,7 +54,7 @@ TEST(SceneParse, OutOfRangeAndConflictingValuesAreErrors) {
 
 TEST(SceneParse, ReadsEveryFieldAsWritten) {
   const SceneDescription s = parseScene(R"({"gravity": [0, 0, -1], "dt": 0.01, "duration": 0.5,
-      "contact_model": "exact", "budget": 64, "max_contacts": 4, "min_substeps": 3,
+      "contact_model": "exact", "budget": 64, "budget_us": 1500, "max_contacts": 4, "min_substeps": 3,
       "min_substep_iterations": 7, "frontier_pair_cost": 5,
       "bodies": [{"name": "a", "box": [1, 2, 3], "static": true},
                  {"name": "b", "sphere": 0.25, "position": [1, 2, 3], "orientation": [0, 0, 0, 2],
@@ -64,6 +66,7 @@ TEST(SceneParse, ReadsEveryFieldAsWritten) {
   EXPECT_EQ(s.steps, 50u);  // 0.5 s / 0.01 s
   EXPECT_EQ(s.world.model, ContactModel::kExact);
   EXPECT_EQ(s.world.budgetTests, 64u);
+  EXPECT_EQ(s.world.budgetMicros, 1500.0);
   EXPECT_EQ(s.world.maxContacts, 4u);
   EXPECT_EQ(s.world.minSubsteps, 3u);
   EXPECT_EQ(s.world.minSubstepIterations, 7u);
