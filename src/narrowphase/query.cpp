@@ -36,6 +36,8 @@ public:
   // unnecessary (0: unknown). The reserve is then the cheaper of answering the frontier and
   // finishing at this query's average time per test so far.
   void setRemainingTests(std::uint64_t tests) { remainingTests_ = tests; }
+  // Does the deadline check use the frontier and remaining tests (else they need no updates)?
+  bool reserving() const { return timed_ && reservePerPair_ > 0.0; }
 
   bool take() {
     if (stopped_) return false;
@@ -91,12 +93,14 @@ private:
   QueryStop stop_ = QueryStop::kFinished;
 };
 
+// Sphere pairs answered between two clock reads of AnswerClock.
+inline constexpr std::uint32_t kAnswerBatch = 8;
+
 // Deadline while the frontier is turned into contacts (QueryBudget::answerWithinDeadline): the
 // first batch of pairs is always answered, then the clock is read once per batch; past the
 // deadline the rest of the frontier -- its lowest-priority end: the traversal leaves the deepest
-// pairs' children first -- gets no contacts (unless none was found yet: next()). Also times the answer, to learn its cost per pair.
-inline constexpr std::uint32_t kAnswerBatch = 8;
-
+// pairs' children first -- gets no contacts (unless none was found yet: next()). Also times the
+// answer, to learn its cost per pair.
 class AnswerClock {
 public:
   // batch: pairs between clock reads, about a microsecond of work each -- kAnswerBatch sphere
@@ -369,7 +373,7 @@ public:
         if (SideA::index(x.a) != SideA::index(y.a)) return SideA::index(x.a) < SideA::index(y.a);
         return SideB::index(x.b) < SideB::index(y.b);
       });
-      if (directPairs_ > 0) {
+      if (directPairs_ > 0 && meter_.reserving()) {
         // Exact model: tests left to finish, at most the frontier pairs' triangle pairs and at
         // most all triangle pairs of the two meshes (the deduplicated total) -- a small mesh
         // pair finishes sooner than its frontier can be answered from the spheres (Meter).
