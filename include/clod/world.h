@@ -85,6 +85,7 @@ struct WorldSettings {
   /// running when it ran out (a query bounded by its test share). Per-query deadlines were
   /// tried first and lost bodies in the 200-body bin: each query's fixed cost is a large part of
   /// a share of a few microseconds, so the pairs late in the order starved (docs/dynamics.md).
+  /// Runs with a time budget are not repeatable bit for bit (the division follows measured time).
   double budgetMicros = 0.0;
   /// The clock budgetMicros is measured with (also passed to the queries); replaceable so tests
   /// can count reads instead of timing. Must be non-null.
