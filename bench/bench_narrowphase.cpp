@@ -207,6 +207,8 @@ void BM_NarrowPhase_Query(benchmark::State& state, int mesh, int pose, ContactMo
   state.counters["finished"] = result.finished ? 1.0 : 0.0;
 }
 
+double percentile(std::vector<double> v, double q);  // accuracy harness, below
+
 // A deadline instead of a test count: the query must return by the deadline plus at most one
 // batch of work (budget.h). Counters: overrun_us_p50 / _p99 (return time - deadline, wall clock,
 // over the iterations), tests, frontier and pairs_answered (last iteration), contacts.
@@ -227,10 +229,8 @@ void BM_NarrowPhase_Deadline(benchmark::State& state, int mesh, int pose, Contac
     overruns.push_back(std::chrono::duration<double, std::micro>(QueryBudget::Clock::now() - s.budget.deadline).count());
     benchmark::DoNotOptimize(result.contacts.data());
   }
-  std::sort(overruns.begin(), overruns.end());
-  const auto at = [&](double q) { return overruns.empty() ? 0.0 : overruns[static_cast<std::size_t>(q * double(overruns.size() - 1))]; };
-  state.counters["overrun_us_p50"] = at(0.5);
-  state.counters["overrun_us_p99"] = at(0.99);
+  state.counters["overrun_us_p50"] = percentile(overruns, 0.5);
+  state.counters["overrun_us_p99"] = percentile(overruns, 0.99);
   state.counters["pairs_answered"] = static_cast<double>(result.pairsAnswered);
   state.counters["frontier"] = static_cast<double>(result.frontier.size());
   state.counters["contacts"] = static_cast<double>(result.contacts.size());
