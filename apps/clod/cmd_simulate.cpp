@@ -99,7 +99,7 @@ int runSimulate(const SimulateOptions& o) {
   if (o.gltf) recorder.emplace(world, names, scene.dt, scene.steps);
   nlohmann::json stepSeconds = nlohmann::json::array();
   nlohmann::json energy = nlohmann::json::array(), spent = nlohmann::json::array(), left = nlohmann::json::array();
-  std::uint64_t testsTotal = 0, skipped = 0, interrupted = 0;
+  std::uint64_t testsTotal = 0, skipped = 0, interrupted = 0, fallbackPairs = 0;
   const auto start = std::chrono::steady_clock::now();
   bool barShown = false;
   for (std::uint32_t step = 1; step <= scene.steps; ++step) {
@@ -120,6 +120,7 @@ int runSimulate(const SimulateOptions& o) {
     testsTotal += r.testsSpent;
     skipped += r.pairsSkipped;
     interrupted += r.pairsInterrupted;
+    fallbackPairs += r.fallbackPairs;
     for (BodyId b : r.leftBounds) {
       left.push_back({{"body", names[b]}, {"step", step}});
       std::cerr << "clod: warning: body '" << names[b] << "' left the world bounds at step " << step
@@ -156,6 +157,7 @@ int runSimulate(const SimulateOptions& o) {
                             {"tests_total", testsTotal},
                             {"pair_queries_skipped", skipped},
                             {"pair_queries_interrupted", interrupted},
+                            {"exact_fallback_pairs", fallbackPairs},
                             {"left_bounds", left},
                             {"shapes_baked", build.shapesBaked},
                             {"shapes_from_cache", build.shapesFromCache},

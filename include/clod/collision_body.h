@@ -79,6 +79,22 @@ public:
   }
   static constexpr std::uint32_t kMaxSphereEdgeDirections = 6;
 
+  /// True when sphere `sphere`'s faceted patch is the whole body and the body is a closed convex
+  /// polyhedron whose edge directions the patch lists (a box, a wedge, a prism): then the
+  /// separating-axis test over the patch's face normals and edge-edge axes gives the true
+  /// penetration depth, and the cfm model's contacts from such a pair carry no error from this
+  /// side (docs/narrow-phase.md, "Faceted pairs").
+  bool patchIsWholeConvexBody(std::uint32_t sphere) const noexcept {
+    return convexPolyhedron_ && spherePatchVertices(sphere).size() == usedVertexCount_ &&
+           !sphereEdgeDirections(sphere).empty();
+  }
+  /// True when the mesh is a closed convex polyhedron (every vertex behind every triangle's
+  /// plane; checked for meshes of at most kMaxConvexCheckTriangles triangles, false above). Then
+  /// every face a patch holds is a face of the body, and the depths of face-on-face contacts
+  /// between patches are exact.
+  bool isConvexPolyhedron() const noexcept { return convexPolyhedron_; }
+  static constexpr std::uint32_t kMaxConvexCheckTriangles = 4096;
+
   /// Bounding-box diagonal of the mesh: the unit of this body's relative tolerances.
   double diagonal() const noexcept { return diagonal_; }
   /// Where the body came from (a bake's source name), for messages; may be empty.
@@ -86,6 +102,11 @@ public:
   void setName(std::string name) { name_ = std::move(name); }
 
 private:
+  struct EdgeRef {  // an undirected edge (v0 < v1) and one triangle holding it
+    std::uint32_t v0, v1, triangle;
+  };
+  void classifyConvexPolyhedron(std::span<const EdgeRef> sortedEdges);
+
   TriangleMesh mesh_;
   SphereTree tree_;
   std::optional<ClosestFeatureMap> map_;
@@ -98,6 +119,8 @@ private:
   std::vector<std::uint32_t> edgeDirectionOffsets_;
   std::vector<Vec3f> edgeDirections_;
   double diagonal_ = 0.0;
+  bool convexPolyhedron_ = false;     // closed and convex (isConvexPolyhedron)
+  std::size_t usedVertexCount_ = 0;   // distinct vertices referenced by triangles
   std::string name_;
 };
 

@@ -128,6 +128,12 @@ struct QueryResult {
   /// Frontier pairs turned into contacts: all of `frontier`, unless a deadline cut the answer
   /// short (QueryBudget::answerWithinDeadline); then the first ones in traversal order.
   std::uint64_t pairsAnswered = 0;
+  /// Exact model only: frontier pairs that did not get their triangle tests (an interrupted
+  /// query) and were answered by `fallbackModel` instead (cfm when both bodies carry closest
+  /// feature maps, else dos); 0 when every contact is a triangle-level one. At an unlimited
+  /// budget it is always 0: the exact model never falls back there.
+  std::uint64_t fallbackPairs = 0;
+  ContactModel fallbackModel = ContactModel::kExact;
   /// Wall-clock seconds the query took.
   double seconds = 0.0;
 };

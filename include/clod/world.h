@@ -148,6 +148,12 @@ struct PairReport {
   std::uint32_t level = 0;     ///< deepest level reached (QueryResult::maxLevel), last query
   bool finished = false;       ///< the last query reached the leaves
   bool skipped = false;        ///< budget gone before its turn in the last substep: old contacts used
+  /// Exact model: frontier pairs of the last query answered by the cfm (or dos) fallback instead
+  /// of triangle tests (QueryResult::fallbackPairs); 0 at an unlimited budget.
+  std::uint64_t fallbackPairs = 0;
+  /// The last query's answer was coarser than the pair's manifold, which still held, so the
+  /// finer manifold was kept (docs/dynamics.md, "Persistent manifold").
+  bool keptFiner = false;
   std::uint32_t contacts = 0;  ///< contacts the solver used in the last substep
 };
 
@@ -168,6 +174,9 @@ struct StepReport {
   double timeSpentMicros = 0.0;
   std::uint64_t pairsSkipped = 0;    ///< pair queries skipped for lack of budget, summed
   std::uint64_t pairsInterrupted = 0;///< queries that stopped before the leaves, summed
+  /// Exact model: frontier pairs answered by the cfm / dos fallback, summed over pairs and
+  /// substeps (PairReport::fallbackPairs); 0 for the other models and at an unlimited budget.
+  std::uint64_t fallbackPairs = 0;
   std::uint32_t solverIterations = 0;///< velocity iterations used, summed over substeps
   /// Substeps whose warm-started velocity solve gained kinetic energy and was redone from zero
   /// impulses (see world.h top; a sign of an unconverged solve).

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 
 #include <Eigen/Eigenvalues>
@@ -90,6 +91,7 @@ struct PairState {
   bool seen = false;         // in this substep's broad phase
   bool fresh = false;        // queried this substep (else: skipped, contacts kept)
   bool interrupted = false;  // the last query stopped at its budget (QueryResult::finished false)
+  bool keptFiner = false;    // the last query's coarser answer was dropped for the finer manifold
 };
 
 std::uint64_t pairKey(BodyId a, BodyId b) { return (std::uint64_t(a) << 32) | b; }
@@ -159,6 +161,7 @@ struct World::Impl {
   void substep(double h, bool limited, std::uint64_t allowance, std::uint64_t nominal, double timeAllowance);
   void solve(double h);
   void persistContacts(PairState& p, const Body& a, const Body& b, double diag);
+  bool keepFinerManifold(PairState& p, const Body& a, const Body& b, double drift);
   double kineticEnergyOfDynamicBodies() const;
   void integrate(double h);
   void checkFinite() const;
@@ -347,9 +350,12 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     pr.tests += result.tests;
     pr.level = result.maxLevel;
     pr.finished = result.finished;
+    pr.fallbackPairs = result.fallbackPairs;
+    report.fallbackPairs += result.fallbackPairs;
     pr.skipped = false;
     if (!result.finished) ++report.pairsInterrupted;
     p->interrupted = !result.finished;
+    p->keptFiner = false;
     p->stale = 0;
     p->fresh = true;
     p->previous.swap(p->contacts);
@@ -448,13 +454,11 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       // first stops the approach (compression impulse), then adds restitution x that impulse
       // (Stronge, "Impact Mechanics", 2000). Decided once, from the pre-solve approach speed.
       cp.restitution = vn < -s.restitutionThreshold ? restitution : 0.0;
-      // Only the part of the depth that is certain is corrected: a sphere-model contact may be
-      // off by its errorBound (the surfaces lie somewhere inside both spheres), so correcting it
-      // would push bodies apart that do not touch (docs/dynamics.md). The contact tree's depth
-      // comes from its distance field (errorBound there is the field's interpolation error, not
-      // a doubt about contact), so it is corrected as it is.
-      const double doubt = s.model == ContactModel::kContactTree ? 0.0 : cp.c.errorBound;
-      const double certain = -cp.separation - doubt - s.slopRel * diag;
+      // Only the part of the depth that is certain is corrected, the same way for every model:
+      // a contact's depth may be off by its errorBound (a coarse sphere pair's surfaces lie
+      // somewhere inside both spheres), so correcting that part would push apart bodies that do
+      // not touch (docs/dynamics.md).
+      const double certain = -cp.separation - cp.c.errorBound - s.slopRel * diag;
       // Correction speed capped: a coarse contact's depth can be a large part of a body, and
       // removing a fifth of it per substep would teleport a small body through its neighbours.
       const double maxCorrection = kMaxCorrectionRel * diag;
@@ -501,6 +505,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
 void World::Impl::persistContacts(PairState& p, const Body& a, const Body& b, double diag) {
   const double matchDistance = 0.05 * diag;
   const double drift = kAnchorDriftRel * diag;
+  if (keepFinerManifold(p, a, b, drift)) return;
   for (auto& old : p.previous) old.matched = false;
   for (SolverContact& cp : p.contacts) {
     const Vec3& n = cp.c.normal;
@@ -528,6 +533,30 @@ void World::Impl::persistContacts(PairState& p, const Body& a, const Body& b, do
       cp.anchorB = match->anchorB;
     }
   }
+}
+
+// A coarser answer never replaces a finer manifold that still holds (the persistent manifold
+// merged by error bound, docs/dynamics.md): when every previous contact of the pair has a smaller
+// error bound than every new one, and each previous contact's anchors have neither slid apart
+// nor opened by more than `drift` since they were found, the previous contacts stay -- measured
+// from their anchors, with their impulses -- and the new, coarser ones are dropped. So a pair
+// whose budget share shrank (more pairs in contact, a deadline) keeps the support its earlier,
+// finer queries found while the bodies have not moved enough to make it wrong, and more budget
+// can only make a pair's contacts finer, never replace them by coarser ones. An empty answer (the
+// query proved the bodies apart) always wins.
+bool World::Impl::keepFinerManifold(PairState& p, const Body& a, const Body& b, double drift) {
+  if (p.contacts.empty() || p.previous.empty()) return false;
+  double newBound = std::numeric_limits<double>::infinity();
+  for (const SolverContact& cp : p.contacts) newBound = std::min(newBound, cp.c.errorBound);
+  for (const SolverContact& old : p.previous) {
+    if (!(old.c.errorBound < newBound)) return false;
+    const Vec3 gap = a.x + a.q * old.anchorA - b.x - b.q * old.anchorB;
+    const double open = gap.dot(old.c.normal);
+    if (open >= drift || (gap - open * old.c.normal).norm() >= drift) return false;
+  }
+  p.contacts.swap(p.previous);
+  p.keptFiner = true;
+  return true;
 }
 
 double World::Impl::kineticEnergyOfDynamicBodies() const {
@@ -797,6 +826,7 @@ const StepReport& World::step(double dt) {
   for (auto& [key, pr] : m.pairReports) {
     auto it = m.pairs.find(key);
     pr.contacts = it == m.pairs.end() ? 0 : std::uint32_t(it->second.contacts.size());
+    pr.keptFiner = it != m.pairs.end() && it->second.keptFiner;
     m.report.pairs.push_back(pr);
   }
   for (auto& [p, ids] : m.order)

@@ -62,9 +62,6 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree) : mesh_(std::mo
   std::vector<Vec3> edgeDirections;
   edgeDirectionOffsets_.assign(1, 0);
   // Edge -> triangle table (sorted by edge), for the coplanar neighbours of patch triangles.
-  struct EdgeRef {
-    std::uint32_t v0, v1, triangle;
-  };
   std::vector<EdgeRef> edges;
   edges.reserve(3 * std::size_t{mesh_.triangleCount()});
   for (std::uint32_t t = 0; t < mesh_.triangleCount(); ++t) {
@@ -135,6 +132,36 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree) : mesh_(std::mo
     faceNormalOffsets_.push_back(static_cast<std::uint32_t>(faceNormals_.size()));
     patchVertexOffsets_.push_back(static_cast<std::uint32_t>(patchVertices_.size()));
   }
+  classifyConvexPolyhedron(edges);
+}
+
+// A closed mesh all of whose vertices lie behind every triangle's plane is a convex polyhedron.
+// O(vertices x triangles), so only meshes of at most kMaxConvexCheckTriangles triangles are
+// checked (larger ones count as not convex: the cfm model then only keeps their error bounds).
+void CollisionBody::classifyConvexPolyhedron(std::span<const EdgeRef> sortedEdges) {
+  std::vector<std::uint32_t> used;
+  for (const auto& t : mesh_.triangles) used.insert(used.end(), t.begin(), t.end());
+  std::sort(used.begin(), used.end());
+  used.erase(std::unique(used.begin(), used.end()), used.end());
+  usedVertexCount_ = used.size();
+  if (mesh_.triangleCount() > kMaxConvexCheckTriangles || mesh_.triangleCount() == 0) return;
+  // Closed: every edge is shared by exactly two triangles.
+  for (std::size_t i = 0; i < sortedEdges.size();) {
+    std::size_t j = i;
+    while (j < sortedEdges.size() && sortedEdges[j].v0 == sortedEdges[i].v0 && sortedEdges[j].v1 == sortedEdges[i].v1) ++j;
+    if (j - i != 2) return;
+    i = j;
+  }
+  const double tolerance = 1e-9 * diagonal_;  // rounding of the vertex coordinates
+  for (std::uint32_t t = 0; t < mesh_.triangleCount(); ++t) {
+    const Vec3 n = mesh_.triangleNormal(t);
+    if (n.squaredNorm() == 0.0) return;
+    const double offset = n.dot(mesh_.corner(t, 0));
+    for (std::uint32_t v : used) {
+      if (n.dot(mesh_.vertices[v]) > offset + tolerance) return;
+    }
+  }
+  convexPolyhedron_ = true;
 }
 
 CollisionBody CollisionBody::fromBake(const BakeContents& bake) {

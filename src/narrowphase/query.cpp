@@ -12,6 +12,7 @@
 
 #include "clod/contact_normal.h"
 #include "clod/error.h"
+#include "face_overlap.h"
 #include "triangle_intersection.h"
 
 namespace clod {
@@ -677,6 +678,78 @@ void snapToFaceNormal(const PatchSide& sideA, const PatchSide& sideB, const Eige
   }
 }
 
+// The face of a faceted side that faces direction `toward` (A frame) most, if within 45 degrees:
+// its plane (the patch's outermost one with that normal) and its corners (the patch vertices on
+// that plane), in A's frame. False when no face of the patch turns that way (an edge or a corner
+// leads).
+bool facingFace(const PatchSide& side, const Vec3& toward, detail::FacePlane& plane, std::array<Vec3, 32>& corners,
+                std::size_t& cornerCount) {
+  constexpr double kMinFacingCos = 0.70710678118654752;  // cos 45 deg
+  double best = kMinFacingCos;
+  bool found = false;
+  for (const Vec3f& f : side.body.sphereFaceNormals(side.sphere)) {
+    const Vec3 fA = side.rotToA ? Vec3(*side.rotToA * f.cast<double>()) : Vec3(f.cast<double>());
+    if (fA.dot(toward) > best) {
+      best = fA.dot(toward);
+      plane.normal = fA;
+      found = true;
+    }
+  }
+  if (!found) return false;
+  std::span<const std::uint32_t> ids = side.body.spherePatchVertices(side.sphere);
+  const TriangleMesh& mesh = side.body.mesh();
+  cornerCount = 0;
+  std::array<Vec3, 32> placed;
+  plane.offset = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < ids.size() && i < placed.size(); ++i) {
+    placed[i] = side.rotToA ? Vec3(*side.rotToA * mesh.vertices[ids[i]] + side.shift) : mesh.vertices[ids[i]];
+    plane.offset = std::max(plane.offset, plane.normal.dot(placed[i]));
+  }
+  // Vertices of one face agree to rounding; 1e-7 diagonals also takes a tessellated face whose
+  // triangles' normals differ by the 1e-6 rad that CollisionBody counts as one normal.
+  const double tolerance = 1e-7 * side.body.diagonal();
+  for (std::size_t i = 0; i < ids.size() && i < placed.size(); ++i) {
+    if (plane.normal.dot(placed[i]) >= plane.offset - tolerance) corners[cornerCount++] = placed[i];
+  }
+  return true;
+}
+
+// Contacts of two faceted patches along the chosen normal c.normal (A frame): where a face of
+// B faces A and a face of A faces B, the corners of the faces' overlap (detail::faceOverlapPoints),
+// each with its own depth (capped, like the single contact's, by the spheres' D&O depth) and
+// the pair's error bound -- a support area instead of one point at its centre, so that friction
+// and tilt have a lever arm at every level (a box sliding on a root-level contact at its face
+// centre tipped over). Edge-on-face and edge-on-edge keep the single contact. Returns false when
+// it added nothing.
+bool facedPatchContacts(const PatchSide& sideA, const PatchSide& sideB, const Contact& c, std::vector<Contact>& out) {
+  detail::FacePlane planeA, planeB;
+  std::array<Vec3, 32> cornersA, cornersB;
+  std::size_t countA = 0, countB = 0;
+  if (!facingFace(sideB, c.normal, planeB, cornersB, countB)) return false;
+  if (!facingFace(sideA, -c.normal, planeA, cornersA, countA)) return false;
+  std::array<detail::FacePoint, detail::kMaxFaceOverlapPoints> points;
+  const std::size_t count = detail::faceOverlapPoints(c.normal, planeB, std::span<const Vec3>(cornersB.data(), countB),
+                                                      planeA, std::span<const Vec3>(cornersA.data(), countA), points);
+  if (count < 2) return false;
+  for (std::size_t i = 0; i < count; ++i) {
+    Contact ci = c;
+    ci.point = points[i].point;
+    ci.depth = std::min(points[i].depth, c.depth);
+    out.push_back(ci);
+  }
+  return true;
+}
+
+// Two faceted patches whose least-overlap axis shows zero depth, and that have no faces facing
+// each other along it, only graze: coplanar side faces lying flush (a box resting on an equal
+// box, shifted along one axis), or a side face standing on the rim of a top face. Such a contact
+// would push sideways along a face that nothing presses on, so it is dropped; the pair's real
+// contact, if any, comes from the pairs holding the faces that do face each other. Zero: within
+// 1e-9 of the bodies' diagonals (rounding).
+bool grazesAtZeroDepth(const PatchSide& sideA, const PatchSide& sideB, const Contact& c) {
+  return c.depth <= 1e-9 * (sideA.body.diagonal() + sideB.body.diagonal());
+}
+
 Vec3 differenceNormal(const Vec3& nA, const Vec3& nB, const Vec3& dosNormal) {
   const Vec3 sum = nB - nA;
   const double len = sum.norm();
@@ -759,8 +832,45 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
       }
     }
     if ((sideA.faceted || sideB.faceted) && !patchDepthAndPoint(sideA, sideB, c.normal, c)) continue;
+    if (sideA.faceted && sideB.faceted) {
+      // Face-on-face corners between two convex polyhedra are exact (their faces are the bodies'
+      // faces); so is everything when both patches are the whole bodies (the separating-axis
+      // theorem). Elsewhere a patch stands for a sphere's part of the surface: r_A + r_B.
+      const bool convex = bodyA.isConvexPolyhedron() && bodyB.isConvexPolyhedron();
+      Contact faces = c;
+      if (convex) faces.errorBound = 0.0;
+      if (facedPatchContacts(sideA, sideB, faces, out)) continue;
+      if (grazesAtZeroDepth(sideA, sideB, c)) continue;
+      if (bodyA.patchIsWholeConvexBody(p.a) && bodyB.patchIsWholeConvexBody(p.b)) c.errorBound = 0.0;
+    }
     out.push_back(c);
   }
+}
+
+// The exact model between two closed convex polyhedra whose root patches are the whole bodies
+// (CollisionBody::patchIsWholeConvexBody): the least-overlap axis over both bodies' face normals
+// and edge-edge cross products is the minimum translation that separates them (the
+// separating-axis theorem for convex polyhedra), so depth and normal are exact, and the
+// overlap of the two faces facing along it is the exact contact polygon (edge contacts: one
+// point). No contact when an axis separates them. Error bound 0.
+void convexPolyhedraContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const Pose& xfAFromB,
+                             std::vector<Contact>& out) {
+  const Eigen::Matrix3d rotAFromB = xfAFromB.rotation.toRotationMatrix();
+  const SphereTree& ta = bodyA.sphereTree();
+  const SphereTree& tb = bodyB.sphereTree();
+  const Vec3 cA = ta.center(0);
+  const Vec3 cB = xfAFromB.apply(tb.center(0));
+  const PatchSide sideA{bodyA, 0, true, cA, ta.radius[0], nullptr, Vec3::Zero()};
+  const PatchSide sideB{bodyB, 0, true, cB, tb.radius[0], &rotAFromB, xfAFromB.translation};
+  const DosContact dos = dosContact(cA, ta.radius[0], cB, tb.radius[0]);
+  Contact c;
+  c.point = dos.point;
+  c.depth = std::numeric_limits<double>::infinity();
+  c.errorBound = 0.0;
+  c.level = 0;
+  if (leastOverlapNormal(sideA, sideB, rotAFromB, Vec3::Zero(), Vec3::Zero(), c.normal) != PatchAxis::kChosen) return;
+  if (!patchDepthAndPoint(sideA, sideB, c.normal, c)) return;
+  if (!facedPatchContacts(sideA, sideB, c, out)) out.push_back(c);
 }
 
 Contact toWorld(const Contact& local, const Pose& xfWorldFromA) {
@@ -1165,12 +1275,22 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
     if (!b.hasContactTree()) throwMissing(b, "B", "contact tree", "contact-tree", kContactTreeOption);
   }
 
+  for (const Pose* pose : {&xfWorldFromA, &xfWorldFromB}) {
+    // A NaN pose would answer "colliding" with NaN contacts; a zero quaternion has no rotation.
+    const double qn = pose->rotation.norm();
+    if (!pose->translation.allFinite() || !std::isfinite(qn) || qn < 1e-12) {
+      throw Error(ErrorCode::kInvalidArgument, std::string("query: the pose of body ") + (pose == &xfWorldFromA ? "A" : "B") +
+                                                   " is not finite or has a zero rotation quaternion");
+    }
+  }
   QueryScratch::Impl& s = scratch.impl();
   const Pose xfAFromB = xfWorldFromA.inverse() * xfWorldFromB;
   double& answerCost = s.answerSecondsPerPair[static_cast<std::size_t>(model)];
   Meter meter(settings.budget, settings.budget.answerWithinDeadline ? answerCost : 0.0);
   result.contacts.clear();
   result.pairsAnswered = 0;
+  result.fallbackPairs = 0;
+  result.fallbackModel = model;
   result.triangleTests = 0;
   result.intersectingTriangles.clear();
   s.raw.clear();
@@ -1181,7 +1301,20 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
   bool finished = false;
   bool exactInterrupted = false;
 
-  if (!cells) {
+  if (model == ContactModel::kExact && a.patchIsWholeConvexBody(0) && b.patchIsWholeConvexBody(0)) {
+    // Two convex polyhedra: the separating-axis test over their face normals and edge-edge axes
+    // gives the exact penetration depth and normal, and clipping the facing faces the exact
+    // contact polygon -- the triangle-level answer, in one test (convexPolyhedraContacts).
+    convexPolyhedraContacts(a, b, xfAFromB, s.raw);
+    meter.take();
+    finished = true;
+    s.sphereFront.assign(1, SpherePair{0, 0, 0.0});
+    fillFrontier(s.sphereFront, SphereSide{a.sphereTree(), a, UINT32_MAX}, SphereSide{b.sphereTree(), b, UINT32_MAX}, result);
+    result.pairsAnswered = 1;
+    result.colliding = !s.raw.empty();
+    if (cache != nullptr) cache->clear();  // nothing to refine: the next query starts from the roots too
+    for (Contact& ct : s.raw) ct = toWorld(ct, xfWorldFromA);
+  } else if (!cells) {
     const std::uint32_t cap = model == ContactModel::kExact ? UINT32_MAX : settings.maxLevel;
     const SphereSide sa{a.sphereTree(), a, cap};
     const SphereSide sb{b.sphereTree(), b, cap};
@@ -1208,6 +1341,8 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
         AnswerClock answer(settings.budget, kAnswerBatch);
         sphereContacts(fallback, a, b, xfAFromB, s.sphereNext, answer, s.raw);
         learnAnswerCost(answer, answerCost);
+        result.fallbackPairs = s.sphereNext.size();
+        result.fallbackModel = fallback;
         result.pairsAnswered += answer.answered();
         finished = false;
         exactInterrupted = fallback == ContactModel::kCfm;

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -42,10 +43,54 @@ CollisionBody bakeLikeTheWorldTest(const TriangleMesh& mesh) {
   return body;
 }
 
+// A box whose faces are each split into n x n squares (two triangles each), welded: more than
+// CollisionBody::kMaxSpherePatchVertices vertices for n >= 3, so no sphere's patch is the whole
+// body and the exact model tests its triangles (a 12-triangle box is answered by the
+// separating-axis test of two convex polyhedra instead).
+TriangleMesh makeGridBox(const Vec3& half, int n) {
+  TriangleMesh mesh;
+  std::map<std::array<long long, 3>, std::uint32_t> index;  // welded grid points, in units of 1/n
+  auto vertex = [&](const std::array<int, 3>& g) {
+    const std::array<long long, 3> key{g[0], g[1], g[2]};
+    auto [it, inserted] = index.try_emplace(key, mesh.vertexCount());
+    if (inserted) mesh.vertices.push_back(Vec3(half.x() * (2.0 * g[0] / n - 1.0), half.y() * (2.0 * g[1] / n - 1.0),
+                                               half.z() * (2.0 * g[2] / n - 1.0)));
+    return it->second;
+  };
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int side = 0; side < 2; ++side) {
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      for (int i = 0; i < n; ++i) {
+        for (int j = 0; j < n; ++j) {
+          auto at = [&](int di, int dj) {
+            std::array<int, 3> g{};
+            g[axis] = side * n;
+            g[u] = i + di;
+            g[v] = j + dj;
+            return vertex(g);
+          };
+          const std::uint32_t a = at(0, 0), b = at(1, 0), c = at(1, 1), d = at(0, 1);
+          // (u, v, axis) is right-handed: counter-clockwise seen from +axis on the far side.
+          if (side == 1) {
+            mesh.triangles.push_back({a, b, c});
+            mesh.triangles.push_back({a, c, d});
+          } else {
+            mesh.triangles.push_back({a, c, b});
+            mesh.triangles.push_back({a, d, c});
+          }
+        }
+      }
+    }
+  }
+  return mesh;
+}
+
 struct SlabBodies {
   // A 4 x 4 x 0.5 slab (top face at z = 0.25) and a unit cube, both centred at their origin.
   CollisionBody slab = bakeLikeTheWorldTest(makeBox(Vec3(2.0, 2.0, 0.25)));
   CollisionBody cube = bakeLikeTheWorldTest(makeBox(Vec3(0.5, 0.5, 0.5)));
+  // The same cube with 3 x 3 squares per face (56 vertices): not a whole-body patch.
+  CollisionBody gridCube = bakeLikeTheWorldTest(makeGridBox(Vec3(0.5, 0.5, 0.5), 3));
 };
 
 const SlabBodies& slabBodies() {
@@ -208,15 +253,17 @@ TEST(CoarseContacts, CfmDropsSpherePairsWhosePatchesAreProvenApart) {
 // the budget.
 TEST(CoarseContacts, InterruptedExactQueryFallsBackToCfmContacts) {
   const SlabBodies& b = slabBodies();
-  ASSERT_TRUE(b.slab.hasClosestFeatureMap() && b.cube.hasClosestFeatureMap());
+  ASSERT_TRUE(b.slab.hasClosestFeatureMap() && b.gridCube.hasClosestFeatureMap());
+  ASSERT_FALSE(b.gridCube.patchIsWholeConvexBody(0));  // else no triangle test would be made
   int interrupted = 0, duringTriangles = 0, contacts = 0;
   for (const Vec3& offset : cubeOffsets()) {
     const Pose poseCube{Quat::Identity(), Vec3(offset.x(), offset.y(), kSlabTop + 0.5 - kPenetration)};
     for (const bool slabIsA : {true, false}) {
-      for (std::uint64_t budget : {std::uint64_t(16), std::uint64_t(64), std::uint64_t(256), std::uint64_t(1024)}) {
+      // 16-256 stop in the sphere traversal of the grid cube, 384 and 512 during its triangle tests.
+      for (std::uint64_t budget : {16, 64, 256, 384, 512}) {
         const QuerySettings settings = settingsFor(ContactModel::kExact, budget);
-        const QueryResult r = slabIsA ? queryContacts(b.slab, Pose{}, b.cube, poseCube, settings)
-                                      : queryContacts(b.cube, poseCube, b.slab, Pose{}, settings);
+        const QueryResult r = slabIsA ? queryContacts(b.slab, Pose{}, b.gridCube, poseCube, settings)
+                                      : queryContacts(b.gridCube, poseCube, b.slab, Pose{}, settings);
         EXPECT_LE(r.tests, budget);
         if (r.finished) continue;
         ++interrupted;
@@ -260,6 +307,10 @@ TEST(CoarseContacts, SmallBodiesOnALargeFloorArePushedAlongTheFloorNormalAtTheRo
       for (std::uint64_t budget : {std::uint64_t(1), std::uint64_t(8), std::uint64_t(16), std::uint64_t(64)}) {
         const std::string what = std::string(isBall ? "ball" : "cube") + " at " + std::to_string(spot.x()) + "," +
                                  std::to_string(spot.y()) + " budget " + std::to_string(budget);
+        // Face planes use the patches' face normals, stored as floats (~6e-8 rad): over the
+        // body's extent that moves a point's height by < 1e-7 of its diagonal; coordinates of
+        // the 20 m floor round at 1e-12 of its size.
+        const double rounding = 1e-7 * body->diagonal() + 1e-12 * floor.diagonal();
         const QueryResult dos = queryContacts(*body, pose, floor, Pose{}, settingsFor(ContactModel::kDos, budget));
         const QueryResult r = queryContacts(*body, pose, floor, Pose{}, settingsFor(ContactModel::kCfm, budget));
         ASSERT_FALSE(r.contacts.empty()) << what;
@@ -274,8 +325,18 @@ TEST(CoarseContacts, SmallBodiesOnALargeFloorArePushedAlongTheFloorNormalAtTheRo
           // Under the body (within its 0.15 half width, plus rounding) and between the floor's
           // top and the body's bottom; depth no deeper than the body's sphere reaches.
           EXPECT_LE(std::hypot(c.point.x() - spot.x(), c.point.y() - spot.y()), 0.15 * std::sqrt(2.0) + 1e-9) << what;
-          EXPECT_LE(std::abs(c.point.z() - 0.5), c.errorBound) << what;
-          EXPECT_LE(std::abs(c.depth - penetration), c.errorBound) << what;
+          // Each contact carries the separation of the two surfaces at its own point (a corner of
+          // a ball's facet lifted off the floor has a smaller or negative depth) and lies midway
+          // between them; its depth is off by at most the error bound -- 0 between convex
+          // polyhedra's facing faces, so rounding of the 20 m floor's coordinates (1e-12 of its
+          // size) is the only slack. No contact is deeper than the body's penetration, and the
+          // deepest one has it.
+          EXPECT_LE(std::abs(c.point.z() - 0.5), c.errorBound + 0.5 * std::abs(c.depth) + rounding) << what;
+          EXPECT_LE(c.depth, penetration + c.errorBound + rounding) << what;
+        }
+        {
+          const Contact& deepest = r.contacts.front();  // deepest first
+          EXPECT_LE(std::abs(deepest.depth - penetration), deepest.errorBound + rounding) << what;
         }
       }
     }

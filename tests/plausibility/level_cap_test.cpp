@@ -38,14 +38,23 @@ TEST(LevelCap, QueriesStopAtTheCappedSphereLevelAndExactIgnoresIt) {
       for (const FrontierPair& p : r.frontier) EXPECT_LE(std::max(p.levelA, p.levelB), cap);
     }
   }
-  // Exact ignores the cap: the same intersecting triangle pairs with and without it.
+  // Exact ignores the cap: the same contacts with and without it (two convex cubes: the
+  // separating-axis answer, the face normal and the overlap's corners).
   qs.model = ContactModel::kExact;
   qs.maxLevel = UINT32_MAX;
   const QueryResult exactFree = queryContacts(cube, a, cube, b, qs);
   qs.maxLevel = 0;
   const QueryResult exactCapped = queryContacts(cube, a, cube, b, qs);
-  EXPECT_FALSE(exactFree.intersectingTriangles.empty());
-  EXPECT_EQ(exactCapped.intersectingTriangles, exactFree.intersectingTriangles);
+  ASSERT_FALSE(exactFree.contacts.empty());
+  ASSERT_EQ(exactCapped.contacts.size(), exactFree.contacts.size());
+  for (std::size_t i = 0; i < exactFree.contacts.size(); ++i) {
+    EXPECT_EQ(exactCapped.contacts[i].point, exactFree.contacts[i].point);
+    EXPECT_EQ(exactCapped.contacts[i].normal, exactFree.contacts[i].normal);
+    EXPECT_EQ(exactCapped.contacts[i].depth, exactFree.contacts[i].depth);
+    // B is A's twin moved 0.95 along +x: the contact normal (B toward A) is -x.
+    EXPECT_NEAR(exactFree.contacts[i].normal.x(), -1.0, 1e-12);
+    EXPECT_NEAR(exactFree.contacts[i].depth, 0.05, 1e-12);
+  }
 }
 
 }  // namespace
