@@ -162,6 +162,9 @@ struct World::Impl {
   void solve(double h);
   void persistContacts(PairState& p, const Body& a, const Body& b, double diag);
   bool keepFinerManifold(PairState& p, const Body& a, const Body& b, double drift);
+  void carryValidContacts(PairState& p, const Body& a, const Body& b, double matchDistance, double drift);
+  void reduceCarried(std::vector<SolverContact>& contacts, std::size_t keep);
+  std::vector<double> spread;  // reduceCarried's farthest-point distances
   double kineticEnergyOfDynamicBodies() const;
   void integrate(double h);
   void checkFinite() const;
@@ -533,6 +536,63 @@ void World::Impl::persistContacts(PairState& p, const Body& a, const Body& b, do
       cp.anchorB = match->anchorB;
     }
   }
+  carryValidContacts(p, a, b, matchDistance, drift);
+}
+
+// The persistent manifold also keeps what the new answer did not repeat (Bullet's persistent
+// manifold does the same): a previous contact that no new one matched, lies farther than the
+// match distance from every new contact, and still holds -- its anchors have neither slid apart
+// nor opened by more than `drift` -- stays, with its anchors and impulses, as long as its normal
+// agrees with the new answer's (within the warm-start cone of some new contact). An answer
+// interrupted at a coarse level often covers only part of the contact region (a contact tree's
+// few frontier cells, a cfm patch pair meeting at one edge); carried over, the earlier points
+// keep the support polygon whole. If the union has more than maxContacts points it is reduced as
+// the narrow phase reduces (deepest by current separation first, then farthest-point sampling in
+// the deepest contact's plane), so it never grows.
+void World::Impl::carryValidContacts(PairState& p, const Body& a, const Body& b, double matchDistance, double drift) {
+  const std::size_t fresh = p.contacts.size();
+  if (fresh == 0) return;  // the query proved the bodies apart: nothing holds
+  for (const SolverContact& old : p.previous) {
+    if (old.matched) continue;
+    const Vec3 pA = a.x + a.q * old.anchorA, pB = b.x + b.q * old.anchorB;
+    const Vec3 gap = pA - pB;
+    const double open = gap.dot(old.c.normal);
+    if (open >= drift || (gap - open * old.c.normal).norm() >= drift) continue;
+    const Vec3 mid = 0.5 * (pA + pB);
+    bool near = false, agrees = false;
+    for (std::size_t i = 0; i < fresh; ++i) {
+      near = near || (p.contacts[i].c.point - mid).norm() < matchDistance;
+      agrees = agrees || p.contacts[i].c.normal.dot(old.c.normal) >= kWarmStartNormalCos;
+    }
+    if (near || !agrees) continue;
+    p.contacts.push_back(old);
+    p.contacts.back().c.point = mid;
+    p.contacts.back().c.depth = -open;
+  }
+  if (p.contacts.size() > settings.maxContacts) reduceCarried(p.contacts, settings.maxContacts);
+}
+
+// Keeps `keep` well-spread contacts: the deepest (by depth, which carried contacts hold as their
+// current separation), then repeatedly the one farthest, in the deepest contact's plane, from
+// those kept. Order of the kept ones: selection order.
+void World::Impl::reduceCarried(std::vector<SolverContact>& contacts, std::size_t keep) {
+  std::size_t deepest = 0;
+  for (std::size_t i = 1; i < contacts.size(); ++i)
+    if (contacts[i].c.depth > contacts[deepest].c.depth) deepest = i;
+  std::swap(contacts[0], contacts[deepest]);
+  const Vec3 n = contacts[0].c.normal;
+  auto planar = [&n](const Vec3& d) { return (d - d.dot(n) * n).squaredNorm(); };
+  spread.assign(contacts.size(), std::numeric_limits<double>::infinity());
+  for (std::size_t k = 1; k < keep; ++k) {
+    std::size_t best = k;
+    for (std::size_t i = k; i < contacts.size(); ++i) {
+      spread[i] = std::min(spread[i], planar(contacts[i].c.point - contacts[k - 1].c.point));
+      if (spread[i] > spread[best]) best = i;
+    }
+    std::swap(contacts[k], contacts[best]);
+    std::swap(spread[k], spread[best]);
+  }
+  contacts.resize(keep);
 }
 
 // A coarser answer never replaces a finer manifold that still holds (the persistent manifold
