@@ -848,10 +848,13 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
       // Face-on-face corners between two convex polyhedra are exact (their faces are the bodies'
       // faces); so is everything when both patches are the whole bodies (the separating-axis
       // theorem). Elsewhere a patch stands for a sphere's part of the surface: r_A + r_B.
+      // Only between convex bodies: on a non-convex patch the outermost face along a normal
+      // need not be the one in contact (a bump's top above the ground plane: clipped against it,
+      // a box sliding on flat ground got the bump's height as depth and jumped 57 mm).
       const bool convex = bodyA.isConvexPolyhedron() && bodyB.isConvexPolyhedron();
       Contact faces = c;
-      if (convex) faces.errorBound = 0.0;
-      if (facedPatchContacts(sideA, sideB, faces, out)) continue;
+      faces.errorBound = 0.0;
+      if (convex && facedPatchContacts(sideA, sideB, faces, out)) continue;
       if (grazesAtZeroDepth(sideA, sideB, c)) continue;
       if (bodyA.patchIsWholeConvexBody(p.a) && bodyB.patchIsWholeConvexBody(p.b)) c.errorBound = 0.0;
     }
