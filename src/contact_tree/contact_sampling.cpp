@@ -119,16 +119,62 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
     i0 = static_cast<int>(std::lround(u.dot(centreO - onPlane) / spacing));
     j0 = static_cast<int>(std::lround(v.dot(centreO - onPlane) / spacing));
   }
-  const int reach = static_cast<int>(std::ceil(radiusMin / spacing));
+  int reach = static_cast<int>(std::ceil(radiusMin / spacing));
+  // A pair of an interrupted query's frontier (a coarse inner cell on either side; a slab's big
+  // flat leaf against a box's root cell): spread the samples over the part of the plane that
+  // lies in both cells instead of over a lattice anchored at S's plane point. (Leaf pairs keep
+  // the anchored lattice: spread over the overlap of two leaves it puts samples right beside the
+  // other body's edges, whose field there points out of its side faces.) The
+  // anchored lattice met a small partner cell in at most a sample or two, often on a cell
+  // border: a box on a slab whose frontier held the slab's eight 2.6 m cells against the box's
+  // root cell got one contact from all eight pairs (the stack then toppled at 256 tests per
+  // frame). The overlap of the two cells' boxes (O's as a box in S's frame), projected onto
+  // the plane, gets perAxis x perAxis samples at the centres of an even grid over it.
+  bool spread = false;
+  Vec3 spreadOrigin = Vec3::Zero();
+  double spreadStepU = 0.0, spreadStepV = 0.0;
+  if (!treeS.isLeaf(cellS.node) || !treeO.isLeaf(cellO.node)) {
+    const Pose xfSFromO = xfWorldFromS.inverse() * xfWorldFromO;
+    const Vec3 minO = treeO.cellMin(cellO), sizeO = Vec3::Constant(hO);
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 corner = minO + Vec3((k & 1) ? sizeO.x() : 0.0, (k & 2) ? sizeO.y() : 0.0, (k & 4) ? sizeO.z() : 0.0);
+      const Vec3 inS = xfSFromO.apply(corner);
+      lo = lo.cwiseMin(inS);
+      hi = hi.cwiseMax(inS);
+    }
+    const Vec3 minS = treeS.cellMin(cellS);
+    lo = lo.cwiseMax(minS);
+    hi = hi.cwiseMin(minS + Vec3::Constant(h));
+    if ((lo.array() <= hi.array()).all()) {
+      double uLo = std::numeric_limits<double>::infinity(), uHi = -uLo, vLo = uLo, vHi = -uLo;
+      for (int k = 0; k < 8; ++k) {
+        const Vec3 corner((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z());
+        uLo = std::min(uLo, u.dot(corner - onPlane));
+        uHi = std::max(uHi, u.dot(corner - onPlane));
+        vLo = std::min(vLo, v.dot(corner - onPlane));
+        vHi = std::max(vHi, v.dot(corner - onPlane));
+      }
+      spread = true;
+      spreadStepU = (uHi - uLo) / perAxis;
+      spreadStepV = (vHi - vLo) / perAxis;
+      spreadOrigin = onPlane + (uLo + 0.5 * spreadStepU) * u + (vLo + 0.5 * spreadStepV) * v;
+      i0 = j0 = 0;
+      reach = static_cast<int>(perAxis) - 1;
+    }
+  }
   const Vec3 normalWorldS = xfWorldFromS.rotation * n;
   const double conflictCos = std::cos(settings.normalConflictDeg * kPi / 180.0);
   const bool flatS = double(hs->fitError) <= kFlatFitRel * h;
   const int layers = settings.offSurfaceDepthRel > 0.0 ? 2 : 1;
   for (int layer = 0; layer < layers; ++layer) {
     const Vec3 layerOrigin = onPlane - (layer * settings.offSurfaceDepthRel * hMin) * n;
-    for (int i = i0 - reach; i <= i0 + reach; ++i) {
-      for (int j = j0 - reach; j <= j0 + reach; ++j) {
-        const Vec3 pS = layerOrigin + (i * spacing) * u + (j * spacing) * v;
+    const int iFirst = spread ? 0 : i0 - reach, jFirst = spread ? 0 : j0 - reach;
+    for (int i = iFirst; i <= i0 + reach; ++i) {
+      for (int j = jFirst; j <= j0 + reach; ++j) {
+        const Vec3 pS = spread ? Vec3(spreadOrigin - (layerOrigin - onPlane).norm() * n + (i * spreadStepU) * u +
+                                      (j * spreadStepV) * v)
+                               : Vec3(layerOrigin + (i * spacing) * u + (j * spacing) * v);
         if (!insideCell(treeS, cellS, pS)) continue;
         const Vec3 pWorld = xfWorldFromS.apply(pS);
         const Vec3 pO = xfWorldFromO.applyInverse(pWorld);

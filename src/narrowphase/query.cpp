@@ -194,11 +194,6 @@ struct CellSide {
   // Cells have no triangle lists: never final before the leaves.
   static std::uint64_t triangleCount(const Node&) { return std::numeric_limits<std::uint32_t>::max(); }
   std::uint32_t maxLevel = UINT32_MAX;  // QuerySettings::maxLevel
-  // cfm without a level cap: a sphere whose patch is the whole convex body is final -- its
-  // children's patches are parts of it, and its contacts are exact already (error bound 0), so
-  // refining it could not change the answer, only its cost (a 10-box pyramid at an unlimited
-  // budget took 68 M tests for 10 s, 1.9x slower than real time).
-  bool wholeBodyIsLeaf = false;
 };
 
 template <class NA, class NB>
