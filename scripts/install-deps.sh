@@ -4,7 +4,7 @@
 #   scripts/install-deps.sh --peers    also the comparison peers used by bench/ (CGAL, Embree, FCL, Bullet, OpenVDB)
 #   scripts/install-deps.sh --fuzz     also clang and its libFuzzer runtime
 set -euo pipefail
-packages=(build-essential cmake ninja-build pkg-config
+packages=(build-essential cmake ninja-build pkg-config ccache
   libeigen3-dev libassimp-dev libtbb-dev nlohmann-json3-dev libcli11-dev libqhull-dev libxxhash-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libtinygltf-dev gnuplot-nox chromium nodejs)

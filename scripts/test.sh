@@ -6,7 +6,15 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 jobs=$(nproc)
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCLOD_BUILD_TESTS=ON
+# A compiler cache: a rebuild of an unchanged file is a cache hit (a second run of this script on
+# the same machine, or CI right after a developer's build); on a fresh machine it costs nothing.
+# base_dir makes the cached objects independent of the checkout's path.
+launcher=()
+if command -v ccache >/dev/null 2>&1; then
+  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$PWD}"
+fi
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCLOD_BUILD_TESTS=ON "${launcher[@]}"
 cmake --build build -j "$jobs"
 ctest --test-dir build -j "$jobs" --output-on-failure
 scripts/test-viewer.sh build/bin/clod  # the web viewer in headless Chromium (docs/viewer.md)
@@ -14,7 +22,7 @@ if [[ "${1:-}" == "--sanitize" ]]; then
   # The library's own tests under the sanitizers; the CLI's end-to-end tests ran in Release above
   # (CLOD_BUILD_CLI, CMakeLists.txt says why).
   cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCLOD_SANITIZE=ON -DCLOD_BUILD_TESTS=ON \
-    -DCLOD_BUILD_CLI=OFF
+    -DCLOD_BUILD_CLI=OFF "${launcher[@]}"
   cmake --build build-asan -j "$jobs"
   ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 CLOD_TEST_SCALE=sanitizer \
     ctest --test-dir build-asan -j "$jobs" --output-on-failure
