@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -30,8 +31,8 @@ struct QueryOptions {
   std::string poseA = "0 0 0 1 0 0 0";
   std::string poseB = "0 0 0 1 0 0 0";
   std::string model = "cfm";
-  std::int64_t budget = -1;
-  double deadlineUs = -1.0;
+  std::string budget;      // empty: unlimited
+  std::string deadlineUs;  // empty: none
   std::int64_t maxContacts = 8;
   bool json = false;
 };
@@ -71,16 +72,14 @@ int runQuery(const QueryOptions& options) {
   settings.model = parseContactModel(options.model);
   const Pose poseA = parsePose(options.poseA, "--pose-a");
   const Pose poseB = parsePose(options.poseB, "--pose-b");
-  if (options.budget == 0 || options.budget < -1) {
-    throw Error(ErrorCode::kInvalidArgument, "--budget " + std::to_string(options.budget) + ": must be >= 1");
+  if (!options.budget.empty()) {
+    settings.budget.maxTests = parseCountOption(options.budget, "--budget", 1, UINT64_MAX);
   }
   if (options.maxContacts < 1 || options.maxContacts > 1024) {
     throw Error(ErrorCode::kInvalidArgument, "--max-contacts " + std::to_string(options.maxContacts) + ": must be 1..1024");
   }
-  if (options.deadlineUs != -1.0 && !(options.deadlineUs >= 0.0 && std::isfinite(options.deadlineUs))) {
-    throw Error(ErrorCode::kInvalidArgument, "--deadline-us must be a finite number >= 0");
-  }
-  if (options.budget > 0) settings.budget.maxTests = static_cast<std::uint64_t>(options.budget);
+  std::optional<double> deadlineUs;
+  if (!options.deadlineUs.empty()) deadlineUs = parseNumberOption(options.deadlineUs, "--deadline-us", 0.0, 1e12);
   settings.maxContacts = static_cast<std::uint32_t>(options.maxContacts);
 
   CollisionBody a = CollisionBody::fromBake(loadBake(options.pathA));
@@ -91,8 +90,8 @@ int runQuery(const QueryOptions& options) {
   QueryScratch scratch;
   QueryResult result;
   // The deadline starts when the query does, not when the files were read.
-  if (options.deadlineUs >= 0.0) {
-    settings.budget.deadline = QueryBudget::microsecondsFromNow(options.deadlineUs).deadline;
+  if (deadlineUs) {
+    settings.budget.deadline = QueryBudget::microsecondsFromNow(*deadlineUs).deadline;
   }
   queryContacts(a, poseA, b, poseB, settings, scratch, result);
 
@@ -140,8 +139,8 @@ const CommandRegistration kRegistration("query", [](CLI::App& app) {
   sub->add_option("--pose-a", options->poseA, "Pose of A: \"tx ty tz qw qx qy qz\" (mesh -> world)")->capture_default_str();
   sub->add_option("--pose-b", options->poseB, "Pose of B, same form")->capture_default_str();
   sub->add_option("--model", options->model, "Contact model: dos, average, cfm, contact-tree, exact")->capture_default_str();
-  sub->add_option("--budget", options->budget, "Most sphere/triangle tests (default: unlimited)");
-  sub->add_option("--deadline-us", options->deadlineUs, "Wall-clock deadline in microseconds; the traversal stops early enough that turning its frontier into contacts ends by it too (include/clod/budget.h)");
+  sub->add_option("--budget", options->budget, "Most sphere/triangle tests, >= 1 (default: unlimited)");
+  sub->add_option("--deadline-us", options->deadlineUs, "Wall-clock deadline in microseconds, >= 0; the traversal stops early enough that turning its frontier into contacts ends by it too (include/clod/budget.h)");
   sub->add_option("--max-contacts", options->maxContacts, "Manifold size, 1..1024")->capture_default_str();
   sub->add_flag("--json", options->json, "Print the result as JSON (colliding, contacts, tests, finished, seconds)");
   return [options] { return runQuery(*options); };

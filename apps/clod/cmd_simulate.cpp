@@ -35,8 +35,8 @@ struct SimulateOptions {
   std::string scene;
   std::string outDir;
   std::string model;
-  std::optional<std::uint64_t> budget;
-  std::optional<double> budgetMicros;
+  std::string budget;        // empty: the scene's
+  std::string budgetMicros;  // empty: the scene's
   bool progress = false;
   bool gltf = false;
   std::string gltfLayers = "spheres,cfm,ctree";
@@ -61,6 +61,7 @@ BodyLayerOptions parseGltfLayers(const std::string& text) {
   return o;
 }
 
+// `name` is already a CSV field (csvField).
 void appendState(std::ostringstream& out, std::uint32_t step, double time, const std::string& name,
                  const RigidBodyState& s) {
   out << step << ',' << time << ',' << name << ',' << s.position.x() << ',' << s.position.y() << ','
@@ -70,31 +71,36 @@ void appendState(std::ostringstream& out, std::uint32_t step, double time, const
 }
 
 int runSimulate(const SimulateOptions& o) {
+  // Usage errors first (exit 2), before the scene is read.
   const BodyLayerOptions layerOptions = parseGltfLayers(o.gltfLayers);
+  std::optional<std::uint64_t> budget;
+  std::optional<double> budgetMicros;
+  if (!o.budget.empty()) budget = parseCountOption(o.budget, "--budget", 0, UINT64_MAX);
+  if (!o.budgetMicros.empty()) budgetMicros = parseNumberOption(o.budgetMicros, "--budget-us", 0.0, 1e9);
+  std::optional<ContactModel> model;
+  if (!o.model.empty()) model = parseContactModel(o.model);
   SceneDescription scene = loadScene(o.scene);
-  if (!o.model.empty()) scene.world.model = parseContactModel(o.model);
-  if (o.budget) scene.world.budgetTests = *o.budget;
-  if (o.budgetMicros) {
-    if (!(*o.budgetMicros >= 0.0 && *o.budgetMicros <= 1e9)) {
-      throw Error(ErrorCode::kInvalidArgument, "--budget-us must be a number in [0, 1e9]");
-    }
-    scene.world.budgetMicros = *o.budgetMicros;
-  }
+  if (model) scene.world.model = *model;
+  if (budget) scene.world.budgetTests = *budget;
+  if (budgetMicros) scene.world.budgetMicros = *budgetMicros;
   const std::filesystem::path out(o.outDir);
   std::error_code ec;
   std::filesystem::create_directories(out, ec);
   if (ec) throw Error(ErrorCode::kFileWriteFailed, o.outDir + ": cannot create directory: " + ec.message());
   SceneBuildReport build;
   World world = buildWorld(scene, out / "bake-cache", &build);
-  std::vector<std::string> names;
-  for (const SceneBody& b : scene.bodies) names.push_back(b.name);
+  std::vector<std::string> names, csvNames;  // csvNames: quoted for the CSV files (RFC 4180)
+  for (const SceneBody& b : scene.bodies) {
+    names.push_back(b.name);
+    csvNames.push_back(csvField(b.name));
+  }
 
   std::ostringstream traj, contacts;
   traj.precision(17);
   contacts.precision(17);
   traj << "step,time,body,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n";
   contacts << "step,body_a,body_b,px,py,pz,nx,ny,nz,depth,level\n";
-  for (BodyId i = 0; i < world.bodyCount(); ++i) appendState(traj, 0, 0.0, names[i], world.state(i));
+  for (BodyId i = 0; i < world.bodyCount(); ++i) appendState(traj, 0, 0.0, csvNames[i], world.state(i));
   std::optional<SimulationRecorder> recorder;
   if (o.gltf) recorder.emplace(world, names, scene.dt, scene.steps);
   nlohmann::json stepSeconds = nlohmann::json::array();
@@ -108,10 +114,10 @@ int runSimulate(const SimulateOptions& o) {
     stepSeconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - stepStart).count());
     const double time = step * scene.dt;
     if (recorder) recorder->recordStep(step, r);
-    for (BodyId i = 0; i < world.bodyCount(); ++i) appendState(traj, step, time, names[i], world.state(i));
+    for (BodyId i = 0; i < world.bodyCount(); ++i) appendState(traj, step, time, csvNames[i], world.state(i));
     for (std::size_t c = 0; c < r.contacts.size(); ++c) {
       const Contact& k = r.contacts[c];
-      contacts << step << ',' << names[r.contactBodies[c][0]] << ',' << names[r.contactBodies[c][1]] << ','
+      contacts << step << ',' << csvNames[r.contactBodies[c][0]] << ',' << csvNames[r.contactBodies[c][1]] << ','
                << k.point.x() << ',' << k.point.y() << ',' << k.point.z() << ',' << k.normal.x() << ','
                << k.normal.y() << ',' << k.normal.z() << ',' << k.depth << ',' << k.level << '\n';
     }

@@ -2,8 +2,10 @@
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <string>
 
 #include "clod/error.h"
+#include "clod/version.h"
 #include "command.h"
 
 namespace clod::cli {
@@ -23,7 +25,7 @@ int main(int argc, char** argv) {
   using namespace clod::cli;
   CLI::App app{"clod: time-critical collision detection and contact generation between rigid triangle meshes"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "clod 0.1.0");
+  app.set_version_flag("--version", std::string("clod ") + clod::version());
 
   std::vector<std::pair<CLI::App*, std::function<int()>>> runners;
   for (auto& command : registeredCommands()) {
@@ -31,11 +33,26 @@ int main(int argc, char** argv) {
     runners.emplace_back(app.get_subcommand(command.name), std::move(run));
   }
 
+  // CLI11 reports an unknown command as "A subcommand is required": name it instead.
+  std::string known;
+  bool isCommand = false;
+  for (const auto& command : registeredCommands()) {
+    known += (known.empty() ? "" : ", ") + command.name;
+    isCommand = isCommand || (argc > 1 && command.name == argv[1]);
+  }
+  if (argc > 1 && argv[1][0] != '-' && !isCommand) {
+    std::cerr << "clod: error [" << clod::errorCodeName(clod::ErrorCode::kInvalidArgument) << "]: unknown command '"
+              << argv[1] << "' (commands: " << known << ")\n";
+    return 2;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    int code = app.exit(e);  // prints help or the usage error
-    return code == 0 ? 0 : 2;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version: CLI11 prints them
+    // Usage errors look like every other error (one line, code named), not like CLI11's text.
+    std::cerr << "clod: error [" << clod::errorCodeName(clod::ErrorCode::kInvalidArgument) << "]: " << e.what()
+              << " (see clod --help)\n";
+    return 2;
   }
 
   try {

@@ -110,7 +110,9 @@ BakeContents decodeBake(std::span<const std::byte> bytes);
 /// encodeBake), kFileWriteFailed naming the path.
 std::size_t saveBake(const std::filesystem::path& path, const BakeContents& contents);
 
-/// Reads a bake file with a single read() of the whole file, then decodes it (decodeBake).
+/// Reads a bake file's header and section table and checks them (checkBakeFileStart) before it
+/// reads the rest with a single read() (so a large file that is not a bake is refused after
+/// 48 bytes), then decodes it (decodeBake).
 /// Throws clod::Error: kFileNotFound, kFileUnreadable, kEmptyFile (zero bytes), and every
 /// error of decodeBake; messages start with the path.
 BakeContents loadBake(const std::filesystem::path& path);

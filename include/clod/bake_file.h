@@ -101,6 +101,17 @@ private:
   std::vector<Pending> sections_;
 };
 
+/// The checks BakeFileReader makes first -- magic, format version, section count, header size,
+/// header checksum (which covers the section table), flags, reserved field and declared size
+/// == `fileBytes` -- made on the first bytes of a file whose whole size is `fileBytes`, so a
+/// loader can refuse a file that is not a bake (or not of the size its header declares)
+/// before it reads, or allocates, the rest: loadBake reads a 1 GiB file of zeros as 48 bytes.
+/// Returns 0 when `start` sufficed; otherwise the number of first bytes the check needs
+/// (at most kBakeHeaderSize + kBakeMaxSections * kBakeTableEntrySize, never more than
+/// `fileBytes`): call again with that many. Throws clod::Error exactly as BakeFileReader
+/// would for the same file. O(section count).
+std::size_t checkBakeFileStart(std::span<const std::byte> start, std::uint64_t fileBytes);
+
 /// Reads the header and section table of a bake file held in memory and checks everything the
 /// container promises before any section is used: magic, format version, header checksum,
 /// total size, every table entry (offset aligned, offset + size inside the file, no overlaps,

@@ -21,6 +21,11 @@ struct MeshLoadOptions {
   /// Flip every triangle of a closed, consistently oriented mesh whose signed volume is
   /// negative (inside-out), so normals point outward.
   bool orientOutward = true;
+  /// glTF JSON (a .gltf file, or the JSON chunk of a .glb) that nests arrays/objects deeper
+  /// than this is refused with kParseError before the importer sees it: the importer's JSON
+  /// parser recurses once per level and would overflow the stack (a 400 kB file nesting
+  /// 200,000 deep crashed it). Real glTF files nest about 5 levels; a few thousand is still safe.
+  std::uint32_t maxJsonDepth = 512;
 };
 
 /// A loaded mesh plus what the loader had to say about it.

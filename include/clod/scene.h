@@ -17,7 +17,7 @@
 // (uniform, mesh files only), "static", "kinematic", "restitution", "friction", "bake"
 // {"method": "octree"|"medial", "depth", "branching", "contact_tree_depth"}.
 //
-// Errors: every unknown key, wrong type or out-of-range value throws
+// Errors: every unknown or duplicate key, wrong type or out-of-range value throws
 // clod::Error(kSceneError) whose message starts with the file and the key's path, e.g.
 // "scene.json: bodies[3].velocity[1]: expected a number".
 

@@ -222,7 +222,9 @@ public:
   const StepReport& step(double dt);
 
   std::size_t bodyCount() const noexcept;
-  RigidBodyState state(BodyId id) const;  ///< id < bodyCount() (CLOD_ASSERT)
+  /// Accessors by id. An id >= bodyCount() throws clod::Error(kInvalidArgument) naming the id
+  /// and the body count, in every build type (not an assert: ids often come from outside).
+  RigidBodyState state(BodyId id) const;
   const RigidBodyDesc& desc(BodyId id) const;  ///< as added (initial state)
   BodyType type(BodyId id) const;  ///< current type (a body that left the bounds is kStatic)
   double mass(BodyId id) const;    ///< 0 for static/kinematic

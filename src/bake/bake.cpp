@@ -4,14 +4,17 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <memory>
+#include <vector>
 
 #define XXH_STATIC_LINKING_ONLY  // XXH3_state_t on the stack: no allocation, no failure path
 #include <xxhash.h>
 
 #include "clod/atomic_file.h"
+#include "clod/bake_file.h"
 #include "clod/error.h"
 #include "cfm_section.h"
 #include "contact_tree_section.h"
@@ -109,24 +112,45 @@ BakeContents loadBake(const std::filesystem::path& path) {
   if (!std::filesystem::exists(status)) throw Error(ErrorCode::kFileNotFound, name + " does not exist");
   if (std::filesystem::is_directory(status)) throw Error(ErrorCode::kFileUnreadable, name + " is a directory");
 
-  // One open, one fstat, and (almost always) one read into a buffer that is not zeroed first:
-  // loading is bounded by the checksums and the copies into the decoded arrays, not by I/O calls.
+  // One open, one fstat, the header (and section table) checked before the rest is read or
+  // even allocated -- a large file that is not a bake costs 48 bytes of reading -- then (almost
+  // always) one read into a buffer that is not zeroed first: loading is bounded by the
+  // checksums and the copies into the decoded arrays, not by I/O calls.
   FileDescriptor file{::open(path.c_str(), O_RDONLY | O_CLOEXEC)};
   if (file.fd < 0) throw Error(ErrorCode::kFileUnreadable, name + ": cannot open: " + std::strerror(errno));
   struct stat info {};
   if (::fstat(file.fd, &info) != 0) throw Error(ErrorCode::kFileUnreadable, name + ": cannot stat: " + std::strerror(errno));
   if (!S_ISREG(info.st_mode)) throw Error(ErrorCode::kFileUnreadable, name + " is not a regular file");
-  const auto size = static_cast<std::size_t>(info.st_size);
+  auto size = static_cast<std::size_t>(info.st_size);
   if (size == 0) throw Error(ErrorCode::kEmptyFile, name + " is empty");
-  auto buffer = std::make_unique_for_overwrite<std::byte[]>(size);
   std::size_t done = 0;
-  while (done < size) {
-    const ssize_t got = ::read(file.fd, buffer.get() + done, size - done);
-    if (got < 0 && errno == EINTR) continue;
-    if (got < 0) throw Error(ErrorCode::kFileUnreadable, name + ": I/O error: " + std::strerror(errno));
-    if (got == 0) break;  // the file shrank since fstat: decode what is there (it will say truncated)
-    done += static_cast<std::size_t>(got);
+  // Reads until `want` bytes are in `into` or the file ends (it shrank since fstat: then the
+  // checks see the shorter size and say truncated).
+  auto readUpTo = [&](std::byte* into, std::size_t want) {
+    while (done < want) {
+      const ssize_t got = ::read(file.fd, into + done, want - done);
+      if (got < 0 && errno == EINTR) continue;
+      if (got < 0) throw Error(ErrorCode::kFileUnreadable, name + ": I/O error: " + std::strerror(errno));
+      if (got == 0) {
+        size = done;
+        break;
+      }
+      done += static_cast<std::size_t>(got);
+    }
+  };
+  std::vector<std::byte> start;
+  try {
+    for (std::size_t need = std::min<std::size_t>(size, kBakeHeaderSize); need != 0;
+         need = checkBakeFileStart({start.data(), done}, size)) {
+      start.resize(need);
+      readUpTo(start.data(), need);
+    }
+  } catch (const Error& e) {
+    throw Error(e.code(), name + ": " + e.what());
   }
+  auto buffer = std::make_unique_for_overwrite<std::byte[]>(size);
+  std::memcpy(buffer.get(), start.data(), done);
+  readUpTo(buffer.get(), size);
   try {
     return decodeBake({buffer.get(), done});
   } catch (const Error& e) {

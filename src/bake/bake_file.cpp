@@ -118,9 +118,13 @@ std::vector<std::byte> BakeFileWriter::encode() const {
   return file;
 }
 
-BakeFileReader::BakeFileReader(std::span<const std::byte> bytes) : bytes_(bytes) {
-  const std::byte* data = bytes.data();
-  const std::size_t size = bytes.size();
+std::size_t checkBakeFileStart(std::span<const std::byte> start, std::uint64_t fileBytes) {
+  const std::byte* data = start.data();
+  const std::uint64_t size = fileBytes;
+  // Whatever the caller holds of the file, never more than the file.
+  const std::uint64_t have = std::min<std::uint64_t>(start.size(), fileBytes);
+  const std::uint64_t headerBytes = std::min<std::uint64_t>(size, kBakeHeaderSize);
+  if (have < headerBytes) return std::size_t(headerBytes);
 
   // The magic first: a file that is not a bake at all should say so, even when short.
   const std::size_t magicBytes = std::min(size, sizeof(kMagic));
@@ -133,10 +137,10 @@ BakeFileReader::BakeFileReader(std::span<const std::byte> bytes) : bytes_(bytes)
   }
   // The version decides the layout of everything after it, so it is checked before the
   // header checksum (a newer format may checksum differently).
-  formatVersion_ = loadLittleEndian<std::uint32_t>(data + 8);
-  if (formatVersion_ == 0) fail(ErrorCode::kBakeCorrupt, "format version 0 is invalid");
-  if (formatVersion_ > kBakeFormatVersion) {
-    fail(ErrorCode::kBakeVersion, "format version " + std::to_string(formatVersion_) +
+  const auto formatVersion = loadLittleEndian<std::uint32_t>(data + 8);
+  if (formatVersion == 0) fail(ErrorCode::kBakeCorrupt, "format version 0 is invalid");
+  if (formatVersion > kBakeFormatVersion) {
+    fail(ErrorCode::kBakeVersion, "format version " + std::to_string(formatVersion) +
                                       " is newer than the newest this build reads (" +
                                       std::to_string(kBakeFormatVersion) + ")");
   }
@@ -162,6 +166,7 @@ BakeFileReader::BakeFileReader(std::span<const std::byte> bytes) : bytes_(bytes)
                                         std::to_string(count) + " entries ends at byte " +
                                         std::to_string(kBakeHeaderSize + tableBytes));
   }
+  if (have < kBakeHeaderSize + tableBytes) return kBakeHeaderSize + tableBytes;
   const std::uint64_t computedHeaderHash = headerChecksum(data, data + kBakeHeaderSize, tableBytes);
   if (computedHeaderHash != storedHeaderHash) {
     fail(ErrorCode::kBakeCorrupt, "header checksum mismatch (stored " + hex(storedHeaderHash) + ", computed " +
@@ -179,6 +184,18 @@ BakeFileReader::BakeFileReader(std::span<const std::byte> bytes) : bytes_(bytes)
     fail(ErrorCode::kBakeCorrupt, "file has " + std::to_string(size) + " bytes, more than the " +
                                       std::to_string(fileSize) + " its header declares");
   }
+  return 0;
+}
+
+BakeFileReader::BakeFileReader(std::span<const std::byte> bytes) : bytes_(bytes) {
+  const std::byte* data = bytes.data();
+  const std::size_t size = bytes.size();
+  // The whole file is here, so the start check always has what it needs.
+  checkBakeFileStart(bytes, size);
+  formatVersion_ = loadLittleEndian<std::uint32_t>(data + 8);
+  const auto count = loadLittleEndian<std::uint32_t>(data + 16);
+  const auto fileSize = loadLittleEndian<std::uint64_t>(data + 24);
+  const std::size_t tableBytes = std::size_t{count} * kBakeTableEntrySize;
 
   entries_.resize(count);
   for (std::uint32_t i = 0; i < count; ++i) {

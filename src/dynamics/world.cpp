@@ -899,15 +899,27 @@ const StepReport& World::step(double dt) {
 
 std::size_t World::bodyCount() const noexcept { return impl_->bodies.size(); }
 
+namespace {
+// An id comes from the caller (often from a file or a loop bound), so it is checked in Release
+// too: one compare per call, against an out-of-bounds read.
+const Body& bodyAt(const std::vector<Body>& bodies, BodyId id, const char* accessor) {
+  if (id >= bodies.size()) {
+    throw Error(ErrorCode::kInvalidArgument, std::string("World::") + accessor + ": body id " + std::to_string(id) +
+                                                 " out of range (the world has " + std::to_string(bodies.size()) +
+                                                 " bodies)");
+  }
+  return bodies[id];
+}
+}  // namespace
+
 RigidBodyState World::state(BodyId id) const {
-  CLOD_ASSERT(id < impl_->bodies.size());
-  const Body& b = impl_->bodies[id];
+  const Body& b = bodyAt(impl_->bodies, id, "state");
   return RigidBodyState{b.x - b.q * b.comLocal, b.q, b.v, b.w};
 }
-const RigidBodyDesc& World::desc(BodyId id) const { return impl_->bodies[id].desc; }
-BodyType World::type(BodyId id) const { return impl_->bodies[id].type; }
+const RigidBodyDesc& World::desc(BodyId id) const { return bodyAt(impl_->bodies, id, "desc").desc; }
+BodyType World::type(BodyId id) const { return bodyAt(impl_->bodies, id, "type").type; }
 double World::mass(BodyId id) const {
-  const Body& b = impl_->bodies[id];
+  const Body& b = bodyAt(impl_->bodies, id, "mass");
   return b.type == BodyType::kDynamic ? b.desc.mass : 0.0;
 }
 

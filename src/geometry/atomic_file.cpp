@@ -8,7 +8,30 @@
 
 namespace clod {
 
+namespace {
+
+const char* fileTypeName(std::filesystem::file_type type) {
+  switch (type) {
+    case std::filesystem::file_type::directory: return "a directory";
+    case std::filesystem::file_type::character: return "a character device";
+    case std::filesystem::file_type::block: return "a block device";
+    case std::filesystem::file_type::fifo: return "a named pipe";
+    case std::filesystem::file_type::socket: return "a socket";
+    default: return "of another kind";
+  }
+}
+
+}  // namespace
+
 void writeFileAtomically(const std::filesystem::path& path, std::string_view content) {
+  // The rename would replace whatever is at `path`: as root, `-o /dev/full` turned the device
+  // into a regular file. Only a regular file (or a link to one) is ours to replace.
+  std::error_code statusError;
+  const auto status = std::filesystem::status(path, statusError);
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+    throw Error(ErrorCode::kFileWriteFailed, "refusing to replace '" + path.string() + "': it is " +
+                                                 fileTypeName(status.type()) + ", not a regular file");
+  }
   std::filesystem::path temp = path;
   temp += ".tmp." + std::to_string(::getpid());
   std::FILE* file = std::fopen(temp.c_str(), "wb");

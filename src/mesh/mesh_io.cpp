@@ -6,6 +6,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <utility>
 
 #include <assimp/DefaultLogger.hpp>
@@ -284,9 +285,17 @@ LoadedMesh convertScene(const aiScene* scene, const CapturedLog& log, const std:
   return finishMesh(std::move(result), ignoredPrimitives, source, options);
 }
 
-void checkText(std::string_view text, const std::string& source) {
+void checkText(std::string_view text, const std::string& source, const MeshLoadOptions& options) {
   if (auto problem = detail::findPlyHeaderProblem(text)) throw Error(ErrorCode::kParseError, source + ": " + *problem);
   if (auto problem = detail::findGlbHeaderProblem(text)) throw Error(ErrorCode::kParseError, source + ": " + *problem);
+  // glTF JSON, plain or in a GLB, is parsed by a recursive parser (MeshLoadOptions::maxJsonDepth).
+  std::optional<std::string_view> json;
+  if (detail::looksLikeGlb(text)) json = detail::glbJsonChunk(text);
+  else if (detail::looksLikeJson(text)) json = text;
+  if (json) {
+    if (auto problem = detail::findJsonDepthProblem(*json, options.maxJsonDepth))
+      throw Error(ErrorCode::kParseError, source + ": " + *problem);
+  }
 }
 
 // OFF goes to our own reader (off_reader.h): by name, or by content whatever the name, because
@@ -329,10 +338,10 @@ LoadedMesh loadMesh(const std::filesystem::path& path, const MeshLoadOptions& op
   }
   std::string format = lowercase(path.extension().string());
   if (!format.empty()) format.erase(0, 1);
-  // The bytes of OBJ, OFF, PLY and GLB files are needed (text_index_check.h, off_reader.h). Assimp
-  // sniffs content whatever the extension, so every file's first bytes are looked at.
+  // The bytes of OBJ, OFF, PLY, glTF and GLB files are needed (text_index_check.h, off_reader.h).
+  // Assimp sniffs content whatever the extension, so every file's first bytes are looked at.
   std::string text;
-  if (format == "obj" || format == "off" || format == "ply" || format == "glb") {
+  if (format == "obj" || format == "off" || format == "ply" || format == "glb" || format == "gltf") {
     text = readWholeFile(path);
   } else {
     char head[64] = {};
@@ -340,12 +349,15 @@ LoadedMesh loadMesh(const std::filesystem::path& path, const MeshLoadOptions& op
       const std::size_t n = std::fread(head, 1, sizeof head, file);
       std::fclose(file);
       const std::string_view headText(head, n);
-      if (detail::looksLikePly(headText) || detail::looksLikeGlb(headText) || useOffReader(format, headText))
+      // All whitespace: it may still be JSON further on (glTF is recognised by content too).
+      const bool blank = headText.find_first_not_of(" \t\r\n") == std::string_view::npos;
+      if (detail::looksLikePly(headText) || detail::looksLikeGlb(headText) || detail::looksLikeJson(headText) ||
+          blank || useOffReader(format, headText))
         text = readWholeFile(path);
     }
   }
   if (useOffReader(format, text)) return loadOff(text, source, options);
-  checkText(text, source);
+  checkText(text, source, options);
 
   Assimp::Importer importer;
   CapturedLog log;
@@ -370,7 +382,7 @@ LoadedMesh loadMeshFromMemory(std::span<const std::byte> bytes, std::string_view
   if (bytes.empty()) throw Error(ErrorCode::kEmptyFile, source + " is empty (0 bytes)");
   const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
   if (useOffReader(format, text)) return loadOff(text, source, options);
-  checkText(text, source);
+  checkText(text, source, options);
 
   Assimp::Importer importer;
   CapturedLog log;

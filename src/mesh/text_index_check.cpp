@@ -120,4 +120,44 @@ std::optional<std::string> findGlbHeaderProblem(std::string_view bytes) {
   return std::nullopt;
 }
 
+bool looksLikeJson(std::string_view text) {
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
+  const std::size_t first = text.find_first_not_of(" \t\r\n");
+  return first != std::string_view::npos && text[first] == '{';
+}
+
+std::optional<std::string_view> glbJsonChunk(std::string_view bytes) {
+  if (!looksLikeGlb(bytes) || bytes.size() < 20) return std::nullopt;
+  auto u32 = [&](std::size_t offset) {
+    const auto* p = reinterpret_cast<const unsigned char*>(bytes.data() + offset);
+    return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24;
+  };
+  constexpr std::uint32_t kJsonChunkType = 0x4E4F534A;  // "JSON", little-endian
+  const std::uint64_t length = u32(12);
+  if (u32(16) != kJsonChunkType || 20 + length > bytes.size()) return std::nullopt;
+  return bytes.substr(20, std::size_t(length));
+}
+
+std::optional<std::string> findJsonDepthProblem(std::string_view json, std::uint32_t maxDepth) {
+  std::uint64_t depth = 0;
+  bool inString = false, escaped = false;
+  for (std::size_t i = 0; i < json.size(); ++i) {
+    const char c = json[i];
+    if (inString) {
+      if (escaped) escaped = false;
+      else if (c == '\\') escaped = true;
+      else if (c == '"') inString = false;
+    } else if (c == '"') {
+      inString = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > maxDepth)
+        return "JSON nests deeper than " + std::to_string(maxDepth) + " levels (at byte " + std::to_string(i) +
+               "; MeshLoadOptions::maxJsonDepth)";
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace clod::detail

@@ -36,4 +36,18 @@ bool looksLikeGlb(std::string_view bytes);
 /// does not fit in the bytes actually there; nullopt otherwise. O(number of chunks).
 std::optional<std::string> findGlbHeaderProblem(std::string_view bytes);
 
+/// True when the first character after whitespace (and a UTF-8 byte order mark) is '{': the
+/// start of a .gltf document, which Assimp recognises by content whatever the extension.
+bool looksLikeJson(std::string_view text);
+
+/// The JSON chunk of GLB content whose header findGlbHeaderProblem accepted (the first chunk,
+/// type "JSON"); nullopt when there is none. O(1).
+std::optional<std::string_view> glbJsonChunk(std::string_view bytes);
+
+/// A message when JSON text nests arrays/objects more than `maxDepth` deep, naming the byte
+/// where it does; nullopt otherwise. Assimp's glTF reader parses JSON recursively, so deep
+/// nesting overflows the stack (200,000 '[' in a 400 kB .gltf crashed `clod inspect`).
+/// A linear scan counting '[' and '{' outside strings: it does not validate the JSON. O(size).
+std::optional<std::string> findJsonDepthProblem(std::string_view json, std::uint32_t maxDepth);
+
 }  // namespace clod::detail

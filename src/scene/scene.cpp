@@ -6,6 +6,8 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <set>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -139,13 +141,60 @@ SceneBody parseBody(const Reader& r, const Json& j, const std::string& path, con
   return b;
 }
 
+// nlohmann::json keeps the last of two equal keys without a word, so {"dt": 0.01, "dt": 0.1}
+// would silently run at 0.1. This parser callback follows the parse with a stack of open
+// containers and refuses a key its object already has, naming the key's path.
+struct DuplicateKeyCheck {
+  struct Open {
+    bool array = false;
+    std::size_t index = 0;           // arrays: elements completed so far
+    std::string key;                 // objects: the key being read
+    std::set<std::string> keys;      // objects: keys seen
+  };
+  explicit DuplicateKeyCheck(const Reader& r) : reader(&r) {}
+  const Reader* reader;
+  std::vector<Open> open;
+
+  std::string path() const {
+    std::string p;
+    for (const Open& o : open) {
+      if (o.array) p += "[" + std::to_string(o.index) + "]";
+      else p += (p.empty() ? "" : ".") + o.key;
+    }
+    return p;
+  }
+  void valueDone() {
+    if (!open.empty() && open.back().array) ++open.back().index;
+  }
+  bool operator()(Json::parse_event_t event, const Json& parsed) {
+    switch (event) {
+      case Json::parse_event_t::object_start: open.emplace_back(); break;
+      case Json::parse_event_t::array_start: open.emplace_back().array = true; break;
+      case Json::parse_event_t::key: {
+        Open& o = open.back();
+        o.key = parsed.get<std::string>();
+        if (!o.keys.insert(o.key).second) reader->fail(path(), "duplicate key");
+        break;
+      }
+      case Json::parse_event_t::object_end:
+      case Json::parse_event_t::array_end:
+        open.pop_back();
+        valueDone();
+        break;
+      case Json::parse_event_t::value: valueDone(); break;
+    }
+    return true;
+  }
+};
+
 }  // namespace
 
 SceneDescription parseScene(std::string_view text, const std::filesystem::path& baseDir, const std::string& fileName) {
   Reader r{fileName};
   Json j;
   try {
-    j = Json::parse(text);
+    DuplicateKeyCheck check(r);
+    j = Json::parse(text, [&check](int, Json::parse_event_t event, Json& parsed) { return check(event, parsed); });
   } catch (const Json::parse_error& e) {
     throw Error(ErrorCode::kSceneError, fileName + ": not valid JSON: " + e.what());
   }
