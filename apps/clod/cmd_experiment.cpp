@@ -94,6 +94,14 @@ const CommandRegistration kRegistration("experiment", [](CLI::App& app) {
   sub->add_option("--seed", options->seed, "seed of every random choice")->capture_default_str();
   sub->add_flag("--quick", options->quick,
                 "reduced configuration for smoke tests (shorter simulations; same keys, not the report's numbers)");
+  sub->add_option("--categories", options->categories,
+                  "degradation: scenarios or categories (stacks, slide, slopes, drops), comma-separated");
+  sub->add_option("--models", options->models, "degradation: contact models, comma-separated (default cfm,contact-tree,exact)");
+  sub->add_option("--budgets", options->budgets, "degradation: tests per frame, comma-separated, 0 = unlimited (default 16,64,256,1024,0)");
+  sub->add_option("--budgets-us", options->budgetsUs, "degradation: narrow-phase microseconds per frame, comma-separated (default 50,200,1000)");
+  sub->add_option("--rates", options->rates, "degradation: frame rates in Hz, comma-separated (default 240,60)");
+  sub->add_option("--duration", options->duration, "degradation: simulated seconds of every run (0 = each scenario's own)")
+      ->check(CLI::NonNegativeNumber);
   return [options] { return options->name == kAll ? runAll(*options) : runOne(*options); };
 });
 

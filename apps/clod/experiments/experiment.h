@@ -37,6 +37,11 @@ struct ExperimentOptions {
   /// `--quick`: a reduced configuration for smoke tests (shorter simulated times, fewer levels);
   /// same JSON keys, but not the numbers the report shows. Experiments without one ignore it.
   bool quick = false;
+  /// degradation: the matrix, as comma-separated lists (empty = the experiment's defaults):
+  /// scenarios or category names, contact models, test budgets, time budgets (µs), rates (Hz);
+  /// and the simulated time of every run (0 = each scenario's own).
+  std::string categories, models, budgets, budgetsUs, rates;
+  double duration = 0.0;
 };
 
 /// One curve of a plot: columns of a CSV file the experiment writes (header line skipped).
