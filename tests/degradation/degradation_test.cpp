@@ -1,0 +1,82 @@
+// Issue 17's scene categories against their analytic outcomes (include/clod/degradation.h): a
+// cut of the matrix that `clod experiment degradation` runs whole. The box categories (5-box
+// stack, twisted stack, 10-box pyramid, a box sliding to rest, a box resting on a 20 deg slope, a
+// box sliding down a 35 deg slope) with cfm and exact at 16, 256 tests per frame and unlimited,
+// 60 Hz, full durations: every criterion of the issue's point 1 (plausible), point 2 (the error
+// at more budget never worse beyond 10 % or 2 mm) and point 3 (real time). Oracle: the analytic
+// answers (rest, v^2 / 2 mu g, a t^2 / 2 with a = g (sin - mu cos)), in runScenario.
+// The mesh drops and the contact-tree model are not in the cut: they do not meet the criteria
+// yet (docs/dynamics.md, "Known limits"); `clod experiment degradation` measures them.
+// Under the sanitizers: the stack and the slide with cfm at 16 tests, 1 s.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "clod/degradation.h"
+#include "support/test_scale.h"
+
+namespace clod {
+namespace {
+
+struct Cell {
+  ScenarioKind kind;
+  ContactModel model;
+};
+
+std::string cellName(const testing::TestParamInfo<Cell>& info) {
+  std::string name = std::string(scenarioName(info.param.kind)) + "_" + std::string(contactModelName(info.param.model));
+  for (char& c : name)
+    if (c == '-') c = '_';
+  return name;
+}
+
+std::vector<Cell> cells() {
+  std::vector<Cell> out;
+  if (test::sanitizerRun()) {
+    return {{ScenarioKind::kStack5, ContactModel::kCfm}, {ScenarioKind::kSlide, ContactModel::kCfm}};
+  }
+  for (ScenarioKind kind : {ScenarioKind::kStack5, ScenarioKind::kStack5Twisted, ScenarioKind::kPyramid10,
+                            ScenarioKind::kSlide, ScenarioKind::kSlopeRest, ScenarioKind::kSlopeSlide})
+    for (ContactModel model : {ContactModel::kCfm, ContactModel::kExact}) out.push_back({kind, model});
+  return out;
+}
+
+class Degradation : public testing::TestWithParam<Cell> {};
+
+TEST_P(Degradation, PlausibleAtEveryBudgetAndNeverWorseWithMore) {
+  const Cell cell = GetParam();
+  const bool light = test::sanitizerRun();
+  const std::vector<std::uint64_t> budgets = light ? std::vector<std::uint64_t>{16} : std::vector<std::uint64_t>{16, 256, 0};
+  std::vector<double> errors;
+  for (std::uint64_t budget : budgets) {
+    ScenarioSettings s;
+    s.model = cell.model;
+    s.budgetTests = budget;
+    s.rateHz = 60.0;
+    s.seconds = light ? 1.0 : 0.0;  // 0: the scenario's own duration (10 s stacks, 4 s slopes)
+    const ScenarioOutcome o = runScenario(cell.kind, s, std::filesystem::path());
+    const std::string what = std::string(scenarioName(cell.kind)) + " " + std::string(contactModelName(cell.model)) +
+                             " budget " + std::to_string(budget);
+    EXPECT_FALSE(o.diverged) << what;
+    EXPECT_FALSE(o.fellThrough) << what;
+    if (!light) {
+      EXPECT_TRUE(o.plausible) << what << ": " << (o.failures.empty() ? std::string() : o.failures.front());
+      // Real time on one core (CPU time of this thread, the machine is shared).
+      EXPECT_LT(o.cpuPerSimSecond, 1.0) << what;
+    }
+    errors.push_back(o.error);
+  }
+  // Budgets in increasing order (unlimited last): each step up may not be worse.
+  for (std::size_t i = 0; i + 1 < errors.size(); ++i)
+    EXPECT_TRUE(degradesMonotonically(errors[i], errors[i + 1]))
+        << scenarioName(cell.kind) << " " << contactModelName(cell.model) << ": error " << errors[i] << " at budget "
+        << budgets[i] << ", " << errors[i + 1] << " at " << budgets[i + 1];
+}
+
+INSTANTIATE_TEST_SUITE_P(BoxScenes, Degradation, testing::ValuesIn(cells()), cellName);
+
+}  // namespace
+}  // namespace clod
