@@ -23,6 +23,8 @@
 namespace clod {
 namespace {
 
+using test::settingsFor;
+
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegree = kPi / 180.0;
 
@@ -54,13 +56,6 @@ struct SlabBodies {
 const SlabBodies& slabBodies() {
   static const SlabBodies b;
   return b;
-}
-
-QuerySettings settingsFor(ContactModel model, std::uint64_t budget) {
-  QuerySettings s;
-  s.model = model;
-  s.budget.maxTests = budget;
-  return s;
 }
 
 // Twice the signed area of triangle (o, a, b) in the xy plane.

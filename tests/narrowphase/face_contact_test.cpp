@@ -16,6 +16,8 @@
 namespace clod {
 namespace {
 
+using test::settingsFor;
+
 constexpr double kDegree = 3.14159265358979323846 / 180.0;
 
 double angleBetween(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
@@ -29,14 +31,6 @@ struct Boxes {
 const Boxes& boxes() {
   static const Boxes b;
   return b;
-}
-
-QuerySettings settingsFor(ContactModel model, std::uint64_t budget) {
-  QuerySettings s;
-  s.model = model;
-  s.budget.maxTests = budget;
-  s.maxContacts = 8;
-  return s;
 }
 
 // Rounding of unit-box coordinates, with margin: 1e-9 of the diagonal (sqrt(3)).

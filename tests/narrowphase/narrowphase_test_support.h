@@ -13,6 +13,8 @@
 #include "clod/proximity.h"
 #include "support/test_scale.h"
 
+#include "clod/query.h"
+
 namespace clod::test {
 
 /// A body with sphere-tree (medial, 8-ary, `depth` levels below the root), closest feature map
@@ -61,6 +63,15 @@ inline Pose randomPose(std::mt19937_64& rng, double spread) {
   p.rotation = Quat(u(rng), u(rng), u(rng), u(rng)).normalized();
   p.translation = spread * Vec3(u(rng), u(rng), u(rng));
   return p;
+}
+
+/// Query settings for `model` at a budget of `budget` tests (kUnlimitedTests: none), manifold of 8.
+inline QuerySettings settingsFor(ContactModel model, std::uint64_t budget) {
+  QuerySettings s;
+  s.model = model;
+  s.budget.maxTests = budget;
+  s.maxContacts = 8;
+  return s;
 }
 
 }  // namespace clod::test

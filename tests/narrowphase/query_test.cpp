@@ -17,6 +17,8 @@
 namespace clod {
 namespace {
 
+using test::settingsFor;
+
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegree = kPi / 180.0;
 
@@ -42,14 +44,6 @@ const Bodies& bodies() {
 const std::vector<std::uint64_t>& budgets() {
   static const std::vector<std::uint64_t> b = {16, 64, 256, 1024, kUnlimitedTests};
   return b;
-}
-
-QuerySettings settingsFor(ContactModel model, std::uint64_t budget) {
-  QuerySettings s;
-  s.model = model;
-  s.budget.maxTests = budget;
-  s.maxContacts = 8;
-  return s;
 }
 
 // Cube A resting face-down on cube B (at the origin), pushed `penetration` into it, offset
