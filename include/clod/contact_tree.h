@@ -148,6 +148,20 @@ struct ContactTree {
   /// O(8^gridDepth). Precondition: a valid tree, depthCap <= 8.
   void buildLookupGrid(std::uint32_t depthCap = 5);
 
+  /// Derived bitmap (not stored in the bake file), one bit per node: the surface crossing the
+  /// cell is one plane, the cell's half-space, within errorAbs. A leaf is flat when its
+  /// half-space's fitError <= errorAbs; an inner cell when it has a half-space, at least one
+  /// surface child, and every surface child is flat and lies on its plane (normals within
+  /// errorAbs / cell size, plane points within errorAbs). A traversal may stop at such a cell
+  /// as at a leaf: its children would only sample the same plane. Filled by
+  /// deriveFlatSurfaces(), which buildContactTree and decodeContactTree call.
+  std::vector<std::uint64_t> flatSurface;
+  void deriveFlatSurfaces();
+  /// True when deriveFlatSurfaces() marked `node` flat (false before it ran). O(1).
+  bool isFlatSurface(std::uint32_t node) const {
+    return (node >> 6) < flatSurface.size() && ((flatSurface[node >> 6] >> (node & 63)) & 1u) != 0;
+  }
+
   // --- Size ---------------------------------------------------------------------------------
   std::uint32_t nodeCount() const { return levelOffsets.empty() ? 0 : levelOffsets.back(); }
   /// Number of depths present (the deepest leaf's depth + 1); 0 for an empty tree.

@@ -85,6 +85,39 @@ bool edgeEdgeNormal(const ContactTree& treeS, const Vec3& pS, const Pose& xfWorl
   return true;
 }
 
+// Where a sample of S lies on S's surface: S's outward normal there (S frame), whether the
+// surface is flat there (the half-space of the cell it lies in fits within kFlatFitRel of the
+// cell's size), that cell's size, and how far from the zero level the sample may lie.
+struct SurfacePoint {
+  Vec3 normal;
+  bool flat;
+  double size;
+  double residual;
+};
+
+// Moves p (S frame) onto the zero level of S's field by Newton steps along the gradient (one
+// step lands on a face, a second settles an edge or a corner). False when it does not get within
+// twice the field's error of the surface in three steps (a point near the medial axis, a
+// vanishing gradient): such a lattice point has no surface point to stand for.
+bool projectOntoSurface(const ContactTree& tree, std::uint32_t maxDepth, Vec3& p, SurfacePoint& at) {
+  for (int step = 0; step < 3; ++step) {
+    const ContactFieldSample f = tree.sample(p, maxDepth);
+    const double length = f.gradient.norm();
+    if (!(length > 1e-12)) return false;
+    at.normal = f.gradient / length;
+    const double tolerance = 2.0 * std::max(tree.errorAbs, f.errorBound);
+    if (std::abs(f.distance) <= tolerance) {
+      const ContactHalfSpace* hs = tree.halfSpace(f.node);
+      at.size = tree.cellSize(f.depth);
+      at.flat = hs && double(hs->fitError) <= kFlatFitRel * at.size;
+      at.residual = std::abs(f.distance);
+      return true;
+    }
+    p -= (f.distance / length) * at.normal;
+  }
+  return false;
+}
+
 void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const Pose& xfWorldFromS,
                      const ContactTree& treeO, const ContactCell& cellO, const Pose& xfWorldFromO,
                      const ContactSamplingSettings& settings, std::vector<ContactPoint>& out,
@@ -163,18 +196,27 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
       reach = static_cast<int>(perAxis) - 1;
     }
   }
-  const Vec3 normalWorldS = xfWorldFromS.rotation * n;
   const double conflictCos = std::cos(settings.normalConflictDeg * kPi / 180.0);
   const bool flatS = double(hs->fitError) <= kFlatFitRel * h;
+  // The plane of an inner cell that holds edges, corners or several faces is no surface (a
+  // slab's 5 m cell fits a plane through the slab's middle, standing on end): its lattice points
+  // would be phantom surface points, and a box sliding over the slab at 256 tests per frame
+  // met such a wall and was thrown back. There the lattice points are moved onto S's surface
+  // along S's own field first (projectOntoSurface), and the normal, flatness and probe radius
+  // are those of the surface where they land. Leaves keep their plane: within a leaf's size
+  // the plane is the surface up to its fit error, and the edge rules below handle the rest.
+  const bool project = !flatS && !treeS.isLeaf(cellS.node);
   const int layers = settings.offSurfaceDepthRel > 0.0 ? 2 : 1;
-  for (int layer = 0; layer < layers; ++layer) {
-    const Vec3 layerOrigin = onPlane - (layer * settings.offSurfaceDepthRel * hMin) * n;
-    const int iFirst = spread ? 0 : i0 - reach, jFirst = spread ? 0 : j0 - reach;
-    for (int i = iFirst; i <= i0 + reach; ++i) {
-      for (int j = jFirst; j <= j0 + reach; ++j) {
-        const Vec3 pS = spread ? Vec3(spreadOrigin - (layerOrigin - onPlane).norm() * n + (i * spreadStepU) * u +
-                                      (j * spreadStepV) * v)
-                               : Vec3(layerOrigin + (i * spacing) * u + (j * spacing) * v);
+  const int iFirst = spread ? 0 : i0 - reach, jFirst = spread ? 0 : j0 - reach;
+  for (int i = iFirst; i <= i0 + reach; ++i) {
+    for (int j = jFirst; j <= j0 + reach; ++j) {
+      Vec3 onSurface = spread ? Vec3(spreadOrigin + (i * spreadStepU) * u + (j * spreadStepV) * v)
+                              : Vec3(onPlane + (i * spacing) * u + (j * spacing) * v);
+      SurfacePoint surface{n, flatS, h, 0.0};
+      if (project && !projectOntoSurface(treeS, settings.maxDepth, onSurface, surface)) continue;
+      const Vec3 normalWorldS = xfWorldFromS.rotation * surface.normal;
+      for (int layer = 0; layer < layers; ++layer) {
+        const Vec3 pS = onSurface - (layer * settings.offSurfaceDepthRel * hMin) * surface.normal;
         if (!insideCell(treeS, cellS, pS)) continue;
         const Vec3 pWorld = xfWorldFromS.apply(pS);
         const Vec3 pO = xfWorldFromO.applyInverse(pWorld);
@@ -185,23 +227,30 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
         if (!(gradientLength > 1e-12)) continue;  // flat interpolant: no direction to push
         Vec3 normal = xfWorldFromO.rotation * (f.gradient / gradientLength);
         const bool conflict = normal.dot(-normalWorldS) < conflictCos;
+        // A sample on a face of ours that only grazes the other body (depth within the field's
+        // error) where the other field turns away from the face: a flush side face seen from the
+        // face beside it. It would push sideways along a face that nothing presses on (the
+        // stacked boxes' side faces); the cfm model drops such contacts too. (Not on an edge of
+        // ours: two crossing edges touch at shallow depths with conflicting fields.)
+        if (conflict && surface.flat && -f.distance <= std::max(f.errorBound, treeO.errorAbs) + surface.residual) continue;
         // Where our cell holds an edge, or the other field disagrees with our plane, two edges
         // may be crossing: if both fields show an edge around the sample, neither gradient
         // alone is the contact normal (each leans toward one of its faces), the common
         // perpendicular of the edges is. The gradients must be probed on both sides of each
         // edge's kink (the leaves there may lie on one side), so the probe radius is twice the
         // larger of the two cells.
-        const double rho = 2.0 * std::max(h, treeO.cellSize(f.depth));
-        if (settings.edgeEdgeNormals && (conflict || !flatS) &&
+        const double rho = 2.0 * std::max(surface.size, treeO.cellSize(f.depth));
+        if (settings.edgeEdgeNormals && (conflict || !surface.flat) &&
             edgeEdgeNormal(treeS, pS, xfWorldFromS, rho, treeO, pO, xfWorldFromO, rho, settings.maxDepth, normal)) {
           if (edgeEdgeCount) ++*edgeEdgeCount;
-        } else if (conflict && flatS) {
+        } else if (conflict && surface.flat) {
           // The other body shows an edge or corner here while our cell is a flat face: an edge
           // or vertex on a face pushes along the face normal, not along the rounded field.
           const ContactHalfSpace* ho = treeO.halfSpace(f.node);
           if (ho && double(ho->fitError) > kFlatFitRel * treeO.cellSize(f.depth)) normal = -normalWorldS;
         }
-        out.push_back({pWorld, normal, -f.distance, f.errorBound, 0});
+        out.push_back({pWorld, normal, -f.distance, f.errorBound + surface.residual, 0});
+        break;  // the off-surface sample below a contact would only repeat it, deeper
       }
     }
   }

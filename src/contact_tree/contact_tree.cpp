@@ -35,7 +35,8 @@ std::size_t ContactTree::memoryBytes() const {
   return nodeWords.size() * sizeof(ContactTreeNodeWord) + errorCode.size() * sizeof(std::uint16_t) +
          levelOffsets.size() * sizeof(std::uint32_t) +
          lattice.size() * sizeof(float) + halfSpaces.size() * sizeof(ContactHalfSpace) + sizeof(rootCorners) +
-         gridNode.size() * sizeof(std::uint32_t) + gridCorners.size() * sizeof(float);
+         gridNode.size() * sizeof(std::uint32_t) + gridCorners.size() * sizeof(float) +
+         flatSurface.size() * sizeof(std::uint64_t);
 }
 
 std::uint16_t ContactTree::encodeErrorRatio(double ratio) {
@@ -69,6 +70,48 @@ void ContactTree::assignNodeBits(const std::vector<std::uint8_t>& interior, cons
     interiorCount += static_cast<std::uint32_t>(std::popcount(word.interior));
     surfaceCount += static_cast<std::uint32_t>(std::popcount(word.surface));
   }
+}
+
+namespace {
+
+// Whether the planes of a cell and of one of its children agree within the tree's error over
+// the parent cell: normals within errorAbs / h (a tilt moves the plane by angle x h across the
+// cell), and the child's plane point within errorAbs of the parent's plane.
+bool coplanar(const ContactTree& t, const ContactCell& parent, const ContactHalfSpace& hp, const ContactCell& child,
+              const ContactHalfSpace& hc) {
+  const Vec3 np(hp.normal[0], hp.normal[1], hp.normal[2]), nc(hc.normal[0], hc.normal[1], hc.normal[2]);
+  const double h = t.cellSize(parent.depth);
+  if (np.cross(nc).norm() * h > t.errorAbs || np.dot(nc) <= 0.0) return false;
+  const Vec3 onChildPlane = t.cellCenter(child) + double(hc.offset) * nc;
+  return std::abs(np.dot(onChildPlane - t.cellCenter(parent)) - double(hp.offset)) <= t.errorAbs;
+}
+
+bool markFlatSurfaces(ContactTree& t, const ContactCell& cell) {
+  const ContactHalfSpace* hs = t.halfSpace(cell.node);
+  bool flat = hs != nullptr;
+  if (t.isLeaf(cell.node)) {
+    flat = flat && double(hs->fitError) <= t.errorAbs;
+  } else {
+    bool anySurface = false;
+    for (std::uint32_t o = 0; o < 8; ++o) {
+      const ContactCell child = t.childCell(cell, o);
+      const bool childFlat = markFlatSurfaces(t, child);  // every child is visited: each gets its bit
+      const ContactHalfSpace* hc = t.halfSpace(child.node);
+      if (!hc) continue;
+      anySurface = true;
+      flat = flat && childFlat && coplanar(t, cell, *hs, child, *hc);
+    }
+    flat = flat && anySurface;
+  }
+  if (flat) t.flatSurface[cell.node >> 6] |= std::uint64_t{1} << (cell.node & 63);
+  return flat;
+}
+
+}  // namespace
+
+void ContactTree::deriveFlatSurfaces() {
+  flatSurface.assign((std::size_t{nodeCount()} + 63) / 64, 0);
+  if (nodeCount() > 0) markFlatSurfaces(*this, rootCell());
 }
 
 void ContactTree::buildLookupGrid(std::uint32_t depthCap) {

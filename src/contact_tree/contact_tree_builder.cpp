@@ -361,6 +361,7 @@ ContactTree Builder::build(ContactTreeBuildStats* stats) {
   st.surfaceCells = tree_.halfSpaces.size();
   if (stats) *stats = st;
   tree_.buildLookupGrid();
+  tree_.deriveFlatSurfaces();
   return std::move(tree_);
 }
 

@@ -108,6 +108,7 @@ ContactTree decodeContactTree(ByteReader& in) {
       fail("halfSpaces[" + std::to_string(i) + "] is not a unit normal with finite offset and fit error");
   }
   tree.buildLookupGrid();
+  tree.deriveFlatSurfaces();
   return tree;
 }
 

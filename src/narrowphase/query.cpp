@@ -175,6 +175,11 @@ struct SphereSide {
   // refining it could not change the answer, only its cost (a 10-box pyramid at an unlimited
   // budget took 68 M tests for 10 s, 1.9x slower than real time).
   bool wholeBodyIsLeaf = false;
+  // Spheres have no planes: a final sphere never prunes the other side's children, and no
+  // sphere pair is final before its leaves for being flat.
+  static bool outsidePlane(Node, const Vec3&, double) { return false; }
+  static bool isFlat(Node) { return false; }
+  static bool isResolved(Node) { return false; }
 };
 
 struct CellSide {
@@ -183,7 +188,35 @@ struct CellSide {
   Node root() const { return tree.rootCell(); }
   Vec3 center(const Node& c) const { return tree.cellCenter(c); }
   double radius(const Node& c) const { return tree.cellRadius(c.depth); }
-  bool isLeaf(const Node& c) const { return tree.isLeaf(c.node) || c.depth >= maxLevel; }
+  // A cell whose surface is one plane within the field's error (a face away from its edges) is
+  // final like a leaf: its children's samples would lie on the same plane, and the field
+  // queries of sampling go to the other tree's leaves anyway. So a box on a box refines only
+  // along the edges, and stops at the faces' largest flat cells (docs/narrow-phase.md).
+  bool isLeaf(const Node& c) const { return tree.isLeaf(c.node) || c.depth >= maxLevel || isFlat(c); }
+  bool isFlat(const Node& c) const { return tree.isFlatSurface(c.node); }
+  // A cell at most 1/8 of its body's diagonal is resolved: a pair of resolved (or flat) cells is
+  // final. Sampling reads the other body's field at its leaves and moves this side's samples
+  // onto its own surface (contact_sampling.cpp), so descending further only adds samples, which
+  // are already spaced at most 1/32 of the diagonal. Edges and corners, where the field is
+  // refined to the tree's depth, otherwise made every leaf along a box's edges a pair of its own
+  // (a box on a slab: 3,668 pairs, 10 ms; a box on an equal box, edges flush: 4,352 leaf pairs,
+  // 34 ms; docs/narrow-phase.md).
+  bool isResolved(const Node& c) const { return tree.cellSize(c.depth) * 8.0 <= tree.meshDiagonal; }
+  // Paper B's half-space test, for a final cell (a leaf or a flat cell): true when the sphere
+  // (centre in this tree's frame) lies on the outer side of the cell's plane, farther than the
+  // plane's distance from the surface in the cell (a leaf's fit error; errorAbs for a flat cell,
+  // whose stored fit error also measured lattice points deep inside the body). Within the cell
+  // the body is below that, so no sample of the pair can be a contact. Without it a large flat
+  // cell's bounding sphere reaches far beyond its face, and the other tree descended to every
+  // leaf inside that sphere (a box on a slab: twice the tests of full refinement).
+  bool outsidePlane(const Node& c, const Vec3& centre, double radius) const {
+    const ContactHalfSpace* hs = tree.halfSpace(c.node);
+    if (!hs) return false;
+    const Vec3 n(hs->normal[0], hs->normal[1], hs->normal[2]);
+    const double surface = tree.isFlatSurface(c.node) ? tree.errorAbs : double(hs->fitError);
+    const double above = n.dot(centre - tree.cellCenter(c)) - double(hs->offset);
+    return above > radius + surface + 1e-6 * tree.cellSize(c.depth);
+  }
   std::uint32_t childCount(const Node&) const { return 8; }
   Node child(const Node& c, std::uint32_t k) const { return tree.childCell(c, k); }
   // A cell the field proves to be wholly outside its body holds neither surface nor interior:
@@ -337,7 +370,7 @@ public:
   // directPairs > 0: a pair whose triangle lists give at most that many triangle pairs is final
   // (the exact model tests its triangles instead of descending further).
   Traversal(const SideA& a, const SideB& b, const Pose& xfAFromB, Meter& meter, std::uint64_t directPairs)
-      : a_(a), b_(b), xfAFromB_(xfAFromB), meter_(meter), directPairs_(directPairs) {}
+      : a_(a), b_(b), xfAFromB_(xfAFromB), xfBFromA_(xfAFromB.inverse()), meter_(meter), directPairs_(directPairs) {}
 
   TestOutcome test(const Vec3& centerA, double radiusA, const Vec3& centerBinA, double radiusB, double& penetration) {
     if (!meter_.take()) return TestOutcome::kOutOfBudget;
@@ -350,6 +383,12 @@ public:
 
   Vec3 centerB(const NB& n) const { return xfAFromB_.apply(b_.center(n)); }
 
+  // A final cell's plane proves the pair apart (CellSide::outsidePlane); never for spheres.
+  bool planeSeparates(const NA& a, const NB& b) const {
+    return (a_.isLeaf(a) && a_.outsidePlane(a, centerB(b), b_.radius(b))) ||
+           (b_.isLeaf(b) && b_.outsidePlane(b, xfBFromA_.apply(a_.center(a)), a_.radius(a)));
+  }
+
   // Re-tests a list of pairs (the roots, or a cached front): overlapping ones go to `front`,
   // separated ones to `separated` (if tracked). When the budget runs out, the untested pairs keep
   // the status they came with (`assumeOverlap`).
@@ -359,7 +398,8 @@ public:
       const Pair& p = pairs[i];
       meter_.setFrontier(front.size() + (pairs.size() - i));
       double pen = 0.0;
-      const TestOutcome o = test(a_.center(p.a), a_.radius(p.a), centerB(p.b), b_.radius(p.b), pen);
+      TestOutcome o = test(a_.center(p.a), a_.radius(p.a), centerB(p.b), b_.radius(p.b), pen);
+      if (o == TestOutcome::kOverlap && planeSeparates(p.a, p.b)) o = TestOutcome::kSeparated;
       if (o == TestOutcome::kOverlap) {
         front.push_back({p.a, p.b, pen});
       } else if (o == TestOutcome::kSeparated) {
@@ -399,7 +439,8 @@ public:
         meter_.setFrontier(next.size() + (front.size() - i));
         const bool leafA = a_.isLeaf(p.a);
         const bool leafB = b_.isLeaf(p.b);
-        if ((leafA && leafB) || a_.triangleCount(p.a) * b_.triangleCount(p.b) <= directPairs_) {
+        if ((leafA && leafB) || a_.triangleCount(p.a) * b_.triangleCount(p.b) <= directPairs_ ||
+            ((a_.isFlat(p.a) || a_.isResolved(p.a)) && (b_.isFlat(p.b) || b_.isResolved(p.b)))) {
           next.push_back(p);
           continue;
         }
@@ -415,11 +456,12 @@ public:
             const NA c = a_.child(p.a, k);
             if (!a_.usable(c)) continue;
             double pen = 0.0;
-            const TestOutcome o = test(a_.center(c), a_.radius(c), cB, rB, pen);
+            TestOutcome o = test(a_.center(c), a_.radius(c), cB, rB, pen);
             if (o == TestOutcome::kOutOfBudget) {
               out = true;
               break;
             }
+            if (o == TestOutcome::kOverlap && planeSeparates(c, p.b)) o = TestOutcome::kSeparated;
             if (o == TestOutcome::kOverlap) {
               next.push_back({c, p.b, pen});
             } else if (separated) {
@@ -432,11 +474,12 @@ public:
             const NB c = b_.child(p.b, k);
             if (!b_.usable(c)) continue;
             double pen = 0.0;
-            const TestOutcome o = test(cA, rA, centerB(c), b_.radius(c), pen);
+            TestOutcome o = test(cA, rA, centerB(c), b_.radius(c), pen);
             if (o == TestOutcome::kOutOfBudget) {
               out = true;
               break;
             }
+            if (o == TestOutcome::kOverlap && planeSeparates(p.a, c)) o = TestOutcome::kSeparated;
             if (o == TestOutcome::kOverlap) {
               next.push_back({p.a, c, pen});
             } else if (separated) {
@@ -463,6 +506,7 @@ private:
   const SideA& a_;
   const SideB& b_;
   MatrixPose xfAFromB_;
+  MatrixPose xfBFromA_;
   Meter& meter_;
   std::uint64_t directPairs_;
 };
