@@ -8,6 +8,9 @@
 // throw clod::Error(kInvalidArgument) naming the parameter.
 
 #include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "clod/mesh.h"
 
@@ -43,5 +46,25 @@ TriangleMesh makeBowl(double outerRadius, double thickness, std::uint32_t segmen
 /// extents x, y). 4 x segments vertices, 8 x segments triangles; genus 1.
 /// Volume, exactly: 8 hx hy hz - 2 hz (segments / 2) holeRadius^2 sin(2 pi / segments). O(segments).
 TriangleMesh makeHoledBlock(const Vec3& halfExtents, double holeRadius, std::uint32_t segments);
+
+/// A named mesh, for writing parts to files.
+struct NamedMesh {
+  std::string name;  ///< file stem, e.g. "ring"
+  TriangleMesh mesh;
+};
+
+/// The parts of the MuJoCo demos in scenes/mujoco/ (`clod generate mujoco-demo -o DIR` writes
+/// them as DIR/<name>.obj; metres):
+///   ring        torus, major radius 25 mm, minor 5 mm (hole radius 20 mm), 48 x 12
+///   ring_peg    cylinder, radius 12 mm, height 100 mm, 32 sides
+///   bowl        bowl, outer radius 90 mm, wall 6 mm, 48 x 12
+///   holed_block block 60 x 60 x 40 mm with a through-hole of radius 10.5 mm, 64 sides
+///   hole_peg    cylinder, radius 10 mm (1 mm less than the hole's diameter), height 60 mm, 32 sides
+std::vector<NamedMesh> demoPartMeshes();
+
+/// The mesh as Wavefront OBJ text: `comment` as '#' lines (may be empty), then one "v x y z"
+/// line per vertex (the shortest decimal form that reads back to the same double, std::to_chars), then one
+/// "f a b c" line per triangle (1-based). Deterministic. O(size).
+std::string encodeObj(const TriangleMesh& mesh, std::string_view comment = {});
 
 }  // namespace clod

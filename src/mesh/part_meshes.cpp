@@ -1,11 +1,13 @@
 #include "clod/part_meshes.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <numbers>
 #include <string>
 
 #include "clod/error.h"
+#include "clod/primitives.h"
 
 namespace clod {
 
@@ -141,6 +143,51 @@ TriangleMesh makeHoledBlock(const Vec3& halfExtents, double holeRadius, std::uin
     addQuad(mesh, n + i, i, j, n + j);                          // hole wall, toward the axis
   }
   return mesh;
+}
+
+std::vector<NamedMesh> demoPartMeshes() {
+  std::vector<NamedMesh> parts;
+  parts.push_back({"ring", makeTorus(0.025, 0.005, 48, 12)});
+  parts.push_back({"ring_peg", makeCylinder(0.012, 0.05, 32)});
+  parts.push_back({"bowl", makeBowl(0.09, 0.006, 48, 12)});
+  parts.push_back({"holed_block", makeHoledBlock(Vec3(0.03, 0.03, 0.02), 0.0105, 64)});
+  parts.push_back({"hole_peg", makeCylinder(0.010, 0.03, 32)});
+  return parts;
+}
+
+std::string encodeObj(const TriangleMesh& mesh, std::string_view comment) {
+  std::string out;
+  out.reserve(40 * mesh.vertices.size() + 24 * mesh.triangles.size() + comment.size() + 16);
+  std::size_t start = 0;
+  while (start < comment.size()) {
+    const std::size_t end = std::min(comment.find('\n', start), comment.size());
+    out += "# ";
+    out += comment.substr(start, end - start);
+    out += '\n';
+    start = end + 1;
+  }
+  char buffer[32];
+  auto number = [&](auto value) {
+    const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
+    out.append(buffer, end);
+  };
+  for (const Vec3& v : mesh.vertices) {
+    out += 'v';
+    for (int k = 0; k < 3; ++k) {
+      out += ' ';
+      number(v[k]);  // shortest round-trip form
+    }
+    out += '\n';
+  }
+  for (const Triangle& t : mesh.triangles) {
+    out += 'f';
+    for (int k = 0; k < 3; ++k) {
+      out += ' ';
+      number(std::uint64_t(t[k]) + 1);
+    }
+    out += '\n';
+  }
+  return out;
 }
 
 }  // namespace clod
