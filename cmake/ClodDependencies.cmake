@@ -10,6 +10,10 @@ find_package(PkgConfig REQUIRED)
 pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)  # section checksums of the bake file (XXH3-64)
 find_package(TinyGLTF REQUIRED)  # scene.glb export (src/export)
 
+# MuJoCo (Debian's libmujoco-dev 2.2.2) for the clod_mujoco plug-in (engines/mujoco); optional.
+if(CLOD_WITH_MUJOCO AND NOT CLOD_SANITIZE)
+  find_package(mujoco 2.2 QUIET)
+endif()
 if(CLOD_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()

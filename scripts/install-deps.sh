@@ -7,7 +7,8 @@ set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config ccache
   libeigen3-dev libassimp-dev libtbb-dev nlohmann-json3-dev libcli11-dev libqhull-dev libxxhash-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libtinygltf-dev gnuplot-nox chromium nodejs)
+  libtinygltf-dev gnuplot-nox chromium nodejs
+  libmujoco-dev)  # MuJoCo 2.2.2: the clod_mujoco plug-in and its tests (engines/mujoco)
 for arg in "$@"; do
   case "$arg" in
     --peers) packages+=(libcgal-dev libembree-dev libfcl-dev libbullet-dev libopenvdb-dev) ;;
