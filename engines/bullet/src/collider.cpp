@@ -24,6 +24,8 @@
 #include <LinearMath/btAabbUtil2.h>
 #include <LinearMath/btPoolAllocator.h>
 
+#include <Eigen/Eigenvalues>
+
 #include "clod/bake.h"
 #include "clod/error.h"
 #include "clod/mass_properties.h"
@@ -54,15 +56,22 @@ void checkSettings(const ColliderSettings& s) {
 
 // ---- MeshShape ----
 
-MeshShape::MeshShape(std::shared_ptr<const CollisionBody> body) : body_(std::move(body)) {
+MeshShape::MeshShape(std::shared_ptr<const CollisionBody> body, const Pose& shapeFromMesh)
+    : body_(std::move(body)), shapeFromMesh_(shapeFromMesh) {
   if (!body_) throw Error(ErrorCode::kInvalidArgument, "clod::bullet::MeshShape: null CollisionBody");
+  if (!shapeFromMesh.rotation.coeffs().allFinite() || !shapeFromMesh.translation.allFinite() ||
+      std::abs(shapeFromMesh.rotation.norm() - 1.0) > 1e-6)
+    throw Error(ErrorCode::kInvalidArgument, "clod::bullet::MeshShape '" + body_->name() +
+                                                 "': shapeFromMesh must be finite with a unit quaternion");
+  shapeFromMesh_.rotation.normalize();
   m_shapeType = CUSTOM_CONCAVE_SHAPE_TYPE;
   const TriangleMesh& mesh = body_->mesh();
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (const std::array<std::uint32_t, 3>& t : mesh.triangles)
     for (std::uint32_t v : t) {
-      lo = lo.cwiseMin(mesh.vertices[v]);
-      hi = hi.cwiseMax(mesh.vertices[v]);
+      const Vec3 p = shapeFromMesh_.apply(mesh.vertices[v]);
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
     }
   if (mesh.triangles.empty()) lo = hi = Vec3::Zero();
   // Rounded outward to float so the box still contains every vertex.
@@ -71,8 +80,26 @@ MeshShape::MeshShape(std::shared_ptr<const CollisionBody> body) : body_(std::mov
   localMax_ = btVector3(std::nextafter(btScalar(hi.x()), 1e30f), std::nextafter(btScalar(hi.y()), 1e30f),
                         std::nextafter(btScalar(hi.z()), 1e30f));
   const MassProperties mp = computeMassPropertiesOrBoundingBox(mesh);
-  const Vec3 perMass = mp.mass > 0.0 ? Vec3(mp.inertia.diagonal() / mp.mass) : Vec3::Zero();
+  const Mat3 r = shapeFromMesh_.rotation.toRotationMatrix();
+  const Vec3 perMass = mp.mass > 0.0 ? Vec3((r * mp.inertia * r.transpose()).diagonal() / mp.mass) : Vec3::Zero();
   unitInertia_ = toBt(perMass);
+}
+
+Pose MeshShape::principalFrame(const TriangleMesh& mesh) {
+  const MassProperties mp = computeMassPropertiesOrBoundingBox(mesh);
+  Mat3 axes = Mat3::Identity();
+  // A tensor already diagonal (boxes, most primitives) keeps the mesh's axes exactly.
+  const Mat3& inertia = mp.inertia;
+  const double offDiagonal = std::abs(inertia(0, 1)) + std::abs(inertia(0, 2)) + std::abs(inertia(1, 2));
+  if (offDiagonal > 1e-12 * inertia.trace()) {
+    Eigen::SelfAdjointEigenSolver<Mat3> eig(inertia);
+    axes = eig.eigenvectors();
+    if (axes.determinant() < 0) axes.col(2) = -axes.col(2);
+  }
+  Pose p;
+  p.rotation = Quat(Mat3(axes.transpose())).normalized();
+  p.translation = -(p.rotation * mp.centerOfMass);
+  return p;
 }
 
 MeshShape::~MeshShape() = default;
@@ -88,7 +115,7 @@ void MeshShape::processAllTriangles(btTriangleCallback* callback, const btVector
   for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
     btVector3 lo(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT), hi = -lo;
     for (int k = 0; k < 3; ++k) {
-      tri[k] = toBt(mesh.vertices[mesh.triangles[i][k]]);
+      tri[k] = toBt(shapeFromMesh_.apply(mesh.vertices[mesh.triangles[i][k]]));
       lo.setMin(tri[k]);
       hi.setMax(tri[k]);
     }
@@ -150,6 +177,11 @@ struct Collider::Core {
     return (m0 && s1->getShapeType() == BOX_SHAPE_PROXYTYPE) || (m1 && s0->getShapeType() == BOX_SHAPE_PROXYTYPE);
   }
   std::shared_ptr<const CollisionBody> bodyOf(const btCollisionShape* shape);
+  /// World pose of the body's mesh coordinates for a shape placed by `t`.
+  static Pose meshPose(const btCollisionShape* shape, const btTransform& t) {
+    const Pose shapePose = toPose(t);
+    return MeshShape::isMeshShape(shape) ? shapePose * static_cast<const MeshShape*>(shape)->shapeFromMesh() : shapePose;
+  }
   void runBatch(btCollisionDispatcher& d, const btDispatcherInfo& info);
 };
 
@@ -273,7 +305,8 @@ void PairAlgorithm::processCollision(const btCollisionObjectWrapper* w0, const b
     qs.budget = QueryBudget::tests(core.settings.budgetTests);  // a lone query (compound child, contactPairTest)
   }
   QueryResult& r = core.result;
-  queryContacts(*a, toPose(w0->getWorldTransform()), *b, toPose(w1->getWorldTransform()), qs, core.scratch, r, &st.cache);
+  queryContacts(*a, Collider::Core::meshPose(w0->getCollisionShape(), w0->getWorldTransform()), *b,
+                Collider::Core::meshPose(w1->getCollisionShape(), w1->getWorldTransform()), qs, core.scratch, r, &st.cache);
   core.report.tests += r.tests;
   if (!r.finished) ++core.report.interrupted;
   st.starved = 0;

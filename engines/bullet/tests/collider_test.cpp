@@ -3,6 +3,7 @@
 // budget, and a non-convex container where the convex hull gives the wrong answer.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <memory>
@@ -369,6 +370,33 @@ TEST(BulletNonConvex, BoxFallsIntoAChannelWhereTheConvexHullHoldsItOnTop) {
   EXPECT_NEAR(clodZ, 0.7, 0.01);
   EXPECT_NEAR(gimpactZ, 0.7, 0.01);
   EXPECT_GT(hullZ, 1.45);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(BulletMeshShape, PrincipalFrameMovesAnOffCentreMeshToItsCentreOfMass) {
+  // A 2 x 1 x 0.5 box whose mesh is centred at (1, 2, 3) and turned 30 deg about z: the principal
+  // frame puts the centre of mass at the origin, and the inertia diagonal in that frame is the
+  // box's principal moments, m (b^2 + c^2) / 12 etc. (analytic; 1e-9 relative covers the mass
+  // integrals' rounding, 1e-5 the float conversion of btVector3).
+  clod::TriangleMesh mesh = clod::makeBox(Vec3(1.0, 0.5, 0.25));
+  const clod::Quat q(Eigen::AngleAxisd(M_PI / 6, Vec3::UnitZ()));
+  for (Vec3& v : mesh.vertices) v = q * v + Vec3(1, 2, 3);
+  const clod::Pose frame = MeshShape::principalFrame(mesh);
+  EXPECT_NEAR(frame.apply(Vec3(1, 2, 3)).norm(), 0.0, 1e-9);
+  MeshShape shape(bakeBody(mesh), frame);
+  const btVector3 mid = 0.5 * (shape.localAabbMin() + shape.localAabbMax());
+  EXPECT_NEAR(mid.length(), 0.0, 1e-5);
+  btVector3 inertia;
+  shape.calculateLocalInertia(12, inertia);
+  std::array<double, 3> got = {inertia.x(), inertia.y(), inertia.z()};
+  std::sort(got.begin(), got.end());
+  EXPECT_NEAR(got[0], 1.0 * 1.0 + 0.5 * 0.5, 1e-5);  // m (b^2 + c^2) / 12 with b = 1, c = 0.5
+  EXPECT_NEAR(got[1], 2.0 * 2.0 + 0.5 * 0.5, 1e-5);
+  EXPECT_NEAR(got[2], 2.0 * 2.0 + 1.0 * 1.0, 1e-5);
+  EXPECT_THROW(MeshShape(bakeBody(mesh), clod::Pose{clod::Quat(2, 0, 0, 0), Vec3::Zero()}), clod::Error);
 }
 
 }  // namespace

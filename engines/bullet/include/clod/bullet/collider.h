@@ -63,27 +63,35 @@ namespace clod::bullet {
 /// A clod body (baked mesh: sphere-tree, closest feature maps, optionally a contact tree) as a
 /// Bullet collision shape. Shape type CUSTOM_CONCAVE_SHAPE_TYPE (a concave shape: Bullet's own
 /// convex-vs-concave algorithm collides convex shapes other than boxes with its triangles, and ray
-/// tests see the triangles too). Local frame = the mesh's coordinates. For a dynamic body Bullet
-/// needs that frame to be the principal frame of inertia with the origin at the centre of mass:
-/// move the mesh there before baking (clod::computeMassProperties gives both), or put the shape in
-/// a btCompoundShape with the child transform. Immutable after construction except for the margin.
+/// tests see the triangles too). The shape's local frame is the mesh's coordinates moved by
+/// `shapeFromMesh` (default: the same). A dynamic btRigidBody needs its shape's local frame to be
+/// the principal frame of inertia with the origin at the centre of mass: principalFrame(mesh) is
+/// that pose, so MeshShape(body, principalFrame(body->mesh())) can be simulated as it is, without
+/// rebaking. Immutable after construction except for the margin.
 class MeshShape : public btConcaveShape {
 public:
-  /// Throws clod::Error(kInvalidArgument) for a null body.
-  explicit MeshShape(std::shared_ptr<const CollisionBody> body);
+  /// Throws clod::Error(kInvalidArgument) for a null body or a non-finite pose.
+  explicit MeshShape(std::shared_ptr<const CollisionBody> body, const Pose& shapeFromMesh = Pose{});
   ~MeshShape() override;
 
   const CollisionBody& body() const noexcept { return *body_; }
   const std::shared_ptr<const CollisionBody>& sharedBody() const noexcept { return body_; }
+  /// Mesh coordinates -> the shape's local coordinates.
+  const Pose& shapeFromMesh() const noexcept { return shapeFromMesh_; }
 
-  /// The mesh's bounding box in local coordinates (no margin).
+  /// The pose taking mesh coordinates to the mesh's principal frame of inertia (solid of uniform
+  /// density; the bounding box for an open mesh): origin at the centre of mass, axes the principal
+  /// axes (right-handed). For a box mesh centred at the origin, the identity.
+  static Pose principalFrame(const TriangleMesh& mesh);
+
+  /// The mesh's bounding box in the shape's local coordinates (no margin).
   const btVector3& localAabbMin() const noexcept { return localMin_; }
   const btVector3& localAabbMax() const noexcept { return localMax_; }
 
   // btCollisionShape / btConcaveShape.
   /// The local bounding box, transformed, grown by the margin (0 unless set). O(1).
   void getAabb(const btTransform& t, btVector3& aabbMin, btVector3& aabbMax) const override;
-  /// Every triangle whose bounding box overlaps [aabbMin, aabbMax] (local coordinates), part id 0,
+  /// Every triangle whose bounding box overlaps [aabbMin, aabbMax] (shape coordinates), part id 0,
   /// index = clod's triangle index. O(triangles): this is Bullet's fallback path (convex shapes,
   /// ray tests), not the mesh-mesh one.
   void processAllTriangles(btTriangleCallback* callback, const btVector3& aabbMin,
@@ -92,8 +100,9 @@ public:
   /// anything else throws clod::Error(kInvalidArgument).
   void setLocalScaling(const btVector3& scaling) override;
   const btVector3& getLocalScaling() const override { return scaling_; }
-  /// Diagonal of the mesh's inertia tensor about its centre of mass for this mass (solid of
-  /// uniform density; the bounding box for an open mesh), see the class comment for the frame.
+  /// Diagonal, in the shape's axes, of the mesh's inertia tensor about its centre of mass for this
+  /// mass (solid of uniform density; the bounding box for an open mesh): the principal moments
+  /// when shapeFromMesh is principalFrame(mesh) (see the class comment).
   void calculateLocalInertia(btScalar mass, btVector3& inertia) const override;
   const char* getName() const override { return "clod::bullet::MeshShape"; }
 
@@ -102,6 +111,7 @@ public:
 
 private:
   std::shared_ptr<const CollisionBody> body_;
+  Pose shapeFromMesh_;
   btVector3 localMin_, localMax_;
   btVector3 scaling_{1, 1, 1};
   btVector3 unitInertia_;  // inertia diagonal per unit mass
