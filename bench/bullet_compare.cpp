@@ -1,7 +1,8 @@
 // bullet_compare: clod's world, Bullet 3.24 with GImpact, and Bullet with clod as its collider
 // (clod_bullet), in one run, on
 //   1. issue 17's box scenes (degradation.h: stack5, stack5-twisted, pyramid10, slide, slope-rest,
-//      slope-slide): ms of wall time per simulated second at each budget, and whether the run meets
+//      slope-slide): ms of wall time per simulated second at each budget (and, as a reference for the
+//      Bullet setup, Bullet with its btBoxShape primitive), and whether the run meets
 //      the scenario's plausibility criteria (clod::judgeScenario, the code clod's own runs are
 //      judged by), plus the frame time (median, p99) of the Bullet runs;
 //   2. the 200-body bin (scenes/bin_200.json): frame time (median, p99) and outcome (bodies that
@@ -11,6 +12,7 @@
 //   bullet_compare [--categories stack5,stack5-twisted,pyramid10,slide,slope-rest,slope-slide]
 //                  [--models cfm,exact] [--budgets 16,64,256,1024,unlimited] [--rate HZ] [--seconds S]
 //                  [--bin-steps N (0 = no bin)] [--bin-budgets 4096,unlimited] [--cache DIR]
+//                  [--gimpact-margin M (metres, default 0.004)]
 //
 // Fairness (as bench/world_compare.cpp, docs/benchmarks/world.md):
 //  - the same triangles everywhere: every body (static ground and slopes included) is the mesh clod
@@ -22,7 +24,11 @@
 //    the pyramid, 1 elsewhere); Bullet runs exactly minSubsteps per frame (stepSimulation(dt, k, dt/k)).
 //  - budgets: clod's world spends its budget per frame; clod_bullet's budget is per Bullet substep,
 //    so clod in Bullet at "budget N per frame" gets ceil(N / k) tests per substep.
-// Times: steady_clock around World::step / stepSimulation only (bakes and world construction excluded).
+// Times: steady_clock around World::step / stepSimulation only (bakes and world construction excluded);
+// the Bullet rows also give the thread's CPU time per frame, whose 99th percentile is not inflated
+// by the scheduler handing the core to another process for a time slice (a few ms) on a busy machine.
+#include <time.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -59,6 +65,7 @@ struct Options {
   std::uint32_t binSteps = 240;
   std::vector<std::uint64_t> binBudgets = {4096, 0};
   std::string cache = CLOD_BINARY_DIR "/bullet-compare-cache";
+  double gimpactMargin = 0.004;
 };
 
 struct UsageError {
@@ -119,6 +126,8 @@ Options parseOptions(int argc, char** argv) {
       o.seconds = parsePositive(flag, value);
     } else if (flag == "--bin-steps") {
       o.binSteps = std::uint32_t(parseCount(flag, value));
+    } else if (flag == "--gimpact-margin") {
+      o.gimpactMargin = parsePositive(flag, value);
     } else if (flag == "--cache") {
       o.cache = value;
     } else {
@@ -153,10 +162,21 @@ btScalar combineRestitutionLikeClod(const btCollisionObject* a, const btCollisio
   return std::max(a->getRestitution(), b->getRestitution());
 }
 
-constexpr btScalar kGImpactMargin = 0.004f;  // m, as world_compare (Bullet's 0.04 default is 4 % of a 1 m box)
+// GImpact's collision margin (m): 4 mm as world_compare by default (Bullet's 0.04 default is 4 % of a
+// 1 m box and 13 % of the bin's 0.3 m bodies); --gimpact-margin changes it.
+btScalar gGImpactMargin = 0.004f;
 
-// A scene in Bullet: every body as GImpact (gimpact) or as clod_bullet's MeshShape, in its mesh's
-// principal frame, with clod's mass and inertia.
+double threadCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+// How Bullet sees the bodies: the mesh as btGImpactMeshShape, the mesh as clod_bullet's MeshShape,
+// or (reference only, not a mesh) boxes as Bullet's btBoxShape primitive.
+enum class Shapes { kGImpact, kClod, kBox };
+
+// A scene in Bullet, every body in its mesh's principal frame with clod's mass and inertia.
 struct BulletScene {
   btDefaultCollisionConfiguration configuration;
   btCollisionDispatcher dispatcher{&configuration};
@@ -176,14 +196,14 @@ struct BulletScene {
   std::vector<std::unique_ptr<btRigidBody>> bodies;
   std::vector<bool> removed;
 
-  BulletScene(const clod::World& tmpl, const clod::SceneDescription& scene, bool gimpact) {
+  BulletScene(const clod::World& tmpl, const clod::SceneDescription& scene, Shapes kind) {
     btGImpactCollisionAlgorithm::registerAlgorithm(&dispatcher);
     gCalculateCombinedFrictionCallback = combineFrictionLikeClod;
     gCalculateCombinedRestitutionCallback = combineRestitutionLikeClod;
     world.setGravity(toBt(scene.world.gravity));
     world.getSolverInfo().m_numIterations = 20;
     world.getSolverInfo().m_restitutionVelocityThreshold = btScalar(scene.world.restitutionThreshold);
-    for (clod::BodyId i = 0; i < tmpl.bodyCount(); ++i) add(tmpl.desc(i), gimpact);
+    for (clod::BodyId i = 0; i < tmpl.bodyCount(); ++i) add(tmpl.desc(i), scene.bodies[i], kind);
     removed.assign(bodies.size(), false);
   }
   ~BulletScene() {
@@ -191,14 +211,19 @@ struct BulletScene {
       if (b->isInWorld()) world.removeRigidBody(b.get());
   }
 
-  const Shape& shapeFor(const clod::RigidBodyDesc& d, bool gimpact) {
+  const Shape& shapeFor(const clod::RigidBodyDesc& d, const clod::SceneBody& sb, Shapes kind) {
     auto& slot = shapes[d.shape.get()];
     if (slot) return *slot;
     slot = std::make_unique<Shape>();
     Shape& s = *slot;
     const clod::TriangleMesh& mesh = d.shape->mesh();
     s.shapeFromMesh = clod::bullet::MeshShape::principalFrame(mesh);
-    if (!gimpact) {
+    if (kind == Shapes::kBox && sb.shape == clod::SceneShapeKind::kBox) {
+      s.shapeFromMesh = clod::Pose{};  // clod's box mesh is centred on its axes
+      s.shape = std::make_unique<btBoxShape>(toBt(sb.halfExtents));
+      return s;
+    }
+    if (kind == Shapes::kClod) {
       s.shape = std::make_unique<clod::bullet::MeshShape>(d.shape, s.shapeFromMesh);
       return s;
     }
@@ -211,14 +236,14 @@ struct BulletScene {
     s.array = std::make_unique<btTriangleIndexVertexArray>(int(mesh.triangleCount()), s.indices.data(), int(3 * sizeof(int)),
                                                            int(mesh.vertexCount()), s.vertices.data(), int(3 * sizeof(btScalar)));
     auto g = std::make_unique<btGImpactMeshShape>(s.array.get());
-    g->setMargin(kGImpactMargin);
+    g->setMargin(gGImpactMargin);
     g->updateBound();
     s.shape = std::move(g);
     return s;
   }
 
-  void add(const clod::RigidBodyDesc& d, bool gimpact) {
-    const Shape& s = shapeFor(d, gimpact);
+  void add(const clod::RigidBodyDesc& d, const clod::SceneBody& sb, Shapes kind) {
+    const Shape& s = shapeFor(d, sb, kind);
     bodyShape.push_back(&s);
     const bool dynamic = d.type == clod::BodyType::kDynamic;
     const clod::Mat3 r = s.shapeFromMesh.rotation.toRotationMatrix();
@@ -257,23 +282,25 @@ double tiltDeg(const clod::Quat& initial, const clod::Quat& current) {
 struct Row {
   std::string scenario, engine, model, budget;
   double msPerSimSecond = 0.0;
-  std::vector<double> frameMs;  // Bullet rows
+  std::vector<double> frameMs, frameCpuMs;  // Bullet rows
   clod::ScenarioOutcome outcome;
   std::uint64_t maxTestsPerFrame = 0;
 };
 
 // A scenario in Bullet (GImpact, or clod as the collider at `budget` tests per frame), judged
 // by clod::judgeScenario.
-Row runBulletScenario(clod::ScenarioKind kind, const clod::SceneDescription& scene, const clod::World& tmpl, bool gimpact,
+Row runBulletScenario(clod::ScenarioKind kind, const clod::SceneDescription& scene, const clod::World& tmpl, Shapes shapes,
                       clod::ContactModel model, std::uint64_t budget) {
-  BulletScene b(tmpl, scene, gimpact);
+  const bool gimpact = shapes != Shapes::kClod;
+  BulletScene b(tmpl, scene, shapes);
   const std::uint32_t k = std::max<std::uint32_t>(1, scene.world.minSubsteps);
   clod::bullet::Collider collider({.model = model, .budgetTests = budget ? (budget + k - 1) / k : 0});
   if (!gimpact) collider.install(b.world);
   Row row;
   row.scenario = std::string(clod::scenarioName(kind));
   row.engine = gimpact ? "Bullet 3.24" : "Bullet 3.24 + clod_bullet";
-  row.model = gimpact ? "GImpact" : std::string(clod::contactModelName(model));
+  row.model = shapes == Shapes::kGImpact ? "GImpact" : shapes == Shapes::kBox ? "btBoxShape (reference, not a mesh)"
+                                                                            : std::string(clod::contactModelName(model));
   row.budget = gimpact ? "-" : budgetName(budget);
   const std::size_t tracked = b.bodies.size() - 1;
   const Vec3 c0 = b.centre(tracked);
@@ -284,9 +311,11 @@ Row runBulletScenario(clod::ScenarioKind kind, const clod::SceneDescription& sce
   const btScalar dt = btScalar(scene.dt);
   double wall = 0.0;
   for (std::uint32_t s = 0; s < scene.steps; ++s) {
+    const double cpu0 = threadCpuSeconds();
     const auto t0 = std::chrono::steady_clock::now();
     b.world.stepSimulation(dt, int(k), dt / btScalar(k));
     const double w = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    row.frameCpuMs.push_back(1e3 * (threadCpuSeconds() - cpu0));
     wall += w;
     row.frameMs.push_back(1e3 * w);
     if (!gimpact) row.maxTestsPerFrame = std::max(row.maxTestsPerFrame, collider.lastDispatch().tests * k);
@@ -327,15 +356,16 @@ Row runBulletScenario(clod::ScenarioKind kind, const clod::SceneDescription& sce
 
 void printScenarioHeader() {
   std::cout << "| scenario | engine | model | budget (tests/frame) | ms per simulated s | frame median ms | frame p99 ms"
-               " | plausible | tracked box moved m | tilt deg | first failure |\n"
-               "|---|---|---|---|---|---|---|---|---|---|---|\n";
+               " | frame CPU p99 ms | plausible | tracked box moved m | tilt deg | first failure |\n"
+               "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
 }
 
 void printScenarioRow(const Row& r) {
   const clod::ScenarioOutcome& o = r.outcome;
   std::cout << "| " << r.scenario << " | " << r.engine << " | " << r.model << " | " << r.budget << " | "
             << fmt(r.msPerSimSecond, 1) << " | " << (r.frameMs.empty() ? "-" : fmt(percentile(r.frameMs, 0.5), 3)) << " | "
-            << (r.frameMs.empty() ? "-" : fmt(percentile(r.frameMs, 0.99), 3)) << " | " << (o.plausible ? "yes" : "**no**")
+            << (r.frameMs.empty() ? "-" : fmt(percentile(r.frameMs, 0.99), 3)) << " | "
+            << (r.frameCpuMs.empty() ? "-" : fmt(percentile(r.frameCpuMs, 0.99), 3)) << " | " << (o.plausible ? "yes" : "**no**")
             << " | " << fmt(o.displacement, 4) << " | " << fmt(o.tiltDeg, 2) << " | "
             << (o.failures.empty() ? "" : o.failures.front()) << " |\n"
             << std::flush;
@@ -345,14 +375,14 @@ void printScenarioRow(const Row& r) {
 
 struct BinRow {
   std::string engine, model, budget;
-  std::vector<double> frameMs;
+  std::vector<double> frameMs, frameCpuMs;
   std::uint32_t leftBounds = 0, outsideBin = 0, dynamicBodies = 0;
   double meanZ = 0.0;
 };
 
 BinRow runBin(const clod::World& tmpl, const clod::SceneDescription& scene, std::uint32_t steps, bool gimpact,
               std::uint64_t budget) {
-  BulletScene b(tmpl, scene, gimpact);
+  BulletScene b(tmpl, scene, gimpact ? Shapes::kGImpact : Shapes::kClod);
   clod::bullet::Collider collider({.model = clod::ContactModel::kCfm, .budgetTests = budget, .maxContacts = scene.world.maxContacts});
   if (!gimpact) collider.install(b.world);
   BinRow row;
@@ -382,9 +412,11 @@ BinRow runBin(const clod::World& tmpl, const clod::SceneDescription& scene, std:
   const btScalar dt = btScalar(scene.dt);
   const clod::Aabb& bounds = scene.world.bounds;
   for (std::uint32_t s = 1; s <= steps; ++s) {
+    const double c0 = threadCpuSeconds();
     const auto t0 = std::chrono::steady_clock::now();
     b.world.stepSimulation(dt, 1, dt);
     row.frameMs.push_back(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    row.frameCpuMs.push_back(1e3 * (threadCpuSeconds() - c0));
     for (std::size_t i = 0; i < b.bodies.size(); ++i) {  // as world_compare: out of bounds -> counted, removed
       if (b.removed[i] || b.bodies[i]->getInvMass() == 0) continue;
       const Vec3 c = b.centre(i);
@@ -416,6 +448,7 @@ BinRow runBin(const clod::World& tmpl, const clod::SceneDescription& scene, std:
 }
 
 int run(const Options& o) {
+  gGImpactMargin = btScalar(o.gimpactMargin);
   std::vector<Row> rows;
   printScenarioHeader();
   for (clod::ScenarioKind kind : o.categories) {
@@ -443,11 +476,13 @@ int run(const Options& o) {
     ss.seconds = o.seconds;
     const clod::SceneDescription scene = clod::makeScenario(kind, ss);
     const clod::World tmpl = clod::buildWorld(scene, o.cache);
-    rows.push_back(runBulletScenario(kind, scene, tmpl, true, clod::ContactModel::kCfm, 0));
-    printScenarioRow(rows.back());
+    for (Shapes shapes : {Shapes::kGImpact, Shapes::kBox}) {
+      rows.push_back(runBulletScenario(kind, scene, tmpl, shapes, clod::ContactModel::kCfm, 0));
+      printScenarioRow(rows.back());
+    }
     for (clod::ContactModel model : o.models)
       for (std::uint64_t budget : o.budgets) {
-        rows.push_back(runBulletScenario(kind, scene, tmpl, false, model, budget));
+        rows.push_back(runBulletScenario(kind, scene, tmpl, Shapes::kClod, model, budget));
         printScenarioRow(rows.back());
       }
   }
@@ -463,12 +498,13 @@ int run(const Options& o) {
     for (std::uint64_t budget : o.binBudgets) bins.push_back(runBin(tmpl, scene, o.binSteps, false, budget));
     std::cout << "\n200-body bin (scenes/bin_200.json), " << o.binSteps << " frames at " << fmt(1.0 / scene.dt, 0)
               << " Hz, 1 Bullet substep per frame:\n\n"
-                 "| engine | model | budget (tests/substep) | frame median ms | frame p99 ms | p99/median | left bounds"
-                 " | outside bin at end | mean z at end m |\n|---|---|---|---|---|---|---|---|---|\n";
+                 "| engine | model | budget (tests/substep) | frame median ms | frame p99 ms | p99/median | CPU median ms"
+                 " | CPU p99 ms | left bounds | outside bin at end | mean z at end m |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const BinRow& r : bins) {
       const double med = percentile(r.frameMs, 0.5), p99 = percentile(r.frameMs, 0.99);
       std::cout << "| " << r.engine << " | " << r.model << " | " << r.budget << " | " << fmt(med, 2) << " | " << fmt(p99, 2)
-                << " | " << fmt(med > 0 ? p99 / med : 0.0, 2) << " | " << r.leftBounds << " | " << r.outsideBin << " of "
+                << " | " << fmt(med > 0 ? p99 / med : 0.0, 2) << " | " << fmt(percentile(r.frameCpuMs, 0.5), 2) << " | "
+                << fmt(percentile(r.frameCpuMs, 0.99), 2) << " | " << r.leftBounds << " | " << r.outsideBin << " of "
                 << r.dynamicBodies << " | " << fmt(r.meanZ, 3) << " |\n";
     }
   }
@@ -483,7 +519,8 @@ int main(int argc, char** argv) {
   } catch (const UsageError& e) {
     if (!e.message.empty()) std::cerr << "bullet_compare: " << e.message << '\n';
     std::cerr << "usage: bullet_compare [--categories stack5,...] [--models cfm,exact] [--budgets 16,64,256,1024,unlimited]\n"
-                 "                      [--rate HZ] [--seconds S] [--bin-steps N] [--bin-budgets 4096,unlimited] [--cache DIR]\n";
+                 "                      [--rate HZ] [--seconds S] [--bin-steps N] [--bin-budgets 4096,unlimited] [--cache DIR]\n"
+                 "                      [--gimpact-margin M]\n";
     return e.message.empty() ? 0 : 2;
   } catch (const clod::Error& e) {
     std::cerr << "bullet_compare: " << e.what() << '\n';
