@@ -328,11 +328,10 @@ void PairAlgorithm::processCollision(const btCollisionObjectWrapper* w0, const b
   }
   core.report.contacts += n;
   if (r.finished) {
-    // The finished answer replaces the manifold: drop the cached points it did not match.
-    const bool swapped = manifold_->getBody0() != w0->getCollisionObject();
+    // The finished answer replaces the manifold: drop the cached points it did not match (the
+    // manifold was made with body0 = w0's object, so no point is swapped).
     for (int k = manifold_->getNumContacts() - 1; k >= 0; --k) {
-      const btManifoldPoint& p = manifold_->getContactPoint(k);
-      const btVector3& onB = swapped ? p.m_positionWorldOnA : p.m_positionWorldOnB;
+      const btVector3& onB = manifold_->getContactPoint(k).m_positionWorldOnB;
       bool found = false;
       for (std::size_t i = 0; i < n && !found; ++i) found = st.added[i] == onB;
       if (!found) manifold_->removeContactPoint(k);

@@ -120,7 +120,8 @@ private:
 /// How the collider answers.
 struct ColliderSettings {
   /// The contact model of every query (contact.h). cfm and average need closest feature maps in
-  /// the bodies (a default bake has them), contact-tree a contact tree.
+  /// the bodies (a default bake has them), contact-tree a contact tree; a body without them makes
+  /// stepSimulation throw clod::Error(kBakeMissingSection) naming it (queryContacts).
   ContactModel model = ContactModel::kCfm;
   /// Sphere/triangle tests per Bullet substep for all clod pairs together; 0 = unlimited.
   std::uint64_t budgetTests = 0;
