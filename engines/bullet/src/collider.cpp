@@ -476,6 +476,9 @@ const DispatchReport& Collider::lastDispatch() const noexcept { return core_->re
 
 void Collider::setSettings(const ColliderSettings& settings) {
   checkSettings(settings);
+  if (core_->world && settings.collideBoxes != core_->settings.collideBoxes)
+    throw Error(ErrorCode::kInvalidArgument,
+                "clod::bullet::Collider::setSettings: collideBoxes changes what install registered; uninstall first");
   if (settings.model != core_->settings.model) {
     ++core_->modelEpoch;
     if (settings.model == ContactModel::kContactTree) core_->boxBodies.clear();  // rebaked with contact trees

@@ -184,6 +184,10 @@ TEST(BulletCollider, InstallUninstallRestoresBulletsAlgorithms) {
     EXPECT_EQ(w.dispatcher.getNearCallback(), &btCollisionDispatcher::defaultNearCallback);
     collider.install(w.world);  // again, then the destructor uninstalls
     EXPECT_FALSE(w.contacts().empty());
+    EXPECT_THROW(collider.setSettings({.collideBoxes = false}), clod::Error);
+    collider.setSettings({.model = clod::ContactModel::kExact, .budgetTests = 8});
+    EXPECT_FALSE(w.contacts().empty());
+    EXPECT_LE(collider.lastDispatch().tests, 8u);
   }
   EXPECT_TRUE(w.contacts().empty());
 }

@@ -174,7 +174,8 @@ public:
 
   const ColliderSettings& settings() const noexcept;
   /// Changes the settings between steps (a model change clears every pair's coherence cache).
-  /// Same checks as the constructor.
+  /// Same checks as the constructor; changing collideBoxes while installed throws
+  /// clod::Error(kInvalidArgument) (uninstall, change, install).
   void setSettings(const ColliderSettings& settings);
 
   /// The last dispatch's figures.
