@@ -302,6 +302,35 @@ TEST(BulletBudget, SharedAcrossPairsAndStarvedPairsComeFirst) {
   for (std::size_t i = 1; i < w.bodies.size(); ++i) EXPECT_GT(w.bodies[i]->getCenterOfMassPosition().z(), 0.45);
 }
 
+TEST(BulletBudget, TimeBudgetSkipsThePairsReachedAfterIt) {
+  // A 1 us budget per substep is gone after the first query (which runs in any case, and makes
+  // at least one batch of tests before it reads the clock): the pairs after it keep their
+  // manifolds, and the starved ones go first next substep. With no time limit every pair is
+  // queried. No timing is asserted (the machine is shared), only which pairs ran.
+  for (double micros : {0.0, 1.0}) {
+    DynWorld w;
+    auto ground = std::make_unique<MeshShape>(boxBody(Vec3(8, 2, 0.25)));
+    w.add(ground.get(), 0, pose(btVector3(0, 0, -0.25f)), 0.6);
+    auto box = std::make_unique<MeshShape>(boxBody(Vec3::Constant(0.5)));
+    for (int k = 0; k < 10; ++k) w.add(box.get(), 1, pose(btVector3(btScalar(-6.75 + 1.5 * k), 0, 0.499f)), 0.6);
+    Collider collider({.model = clod::ContactModel::kCfm, .budgetMicros = micros});
+    collider.install(w.world);
+    std::uint32_t skipped = 0;
+    for (int step = 0; step < 6; ++step) {
+      w.world.stepSimulation(1.0f / 60, 1, 1.0f / 60);
+      EXPECT_EQ(collider.lastDispatch().pairs, 10u);
+      EXPECT_GE(collider.lastDispatch().queried, 1u);
+      skipped += collider.lastDispatch().skipped;
+    }
+    if (micros > 0) {
+      EXPECT_GT(skipped, 0u);
+    } else {
+      EXPECT_EQ(skipped, 0u);
+      for (std::size_t i = 1; i < w.bodies.size(); ++i) EXPECT_GT(w.bodies[i]->getCenterOfMassPosition().z(), 0.45);
+    }
+  }
+}
+
 // ---- a non-convex case ----
 
 // A U-shaped channel as one mesh: a floor slab and two walls (three closed boxes in one mesh, the

@@ -28,7 +28,8 @@
 // = approach speed along its last normal + its last deepest depth / dt; walking down the list each
 // pair gets share = tests left / pairs left (at least 1 while any is left), and what it does not use
 // rolls over to the pairs after it. A time budget does the same with the microseconds left, as a
-// deadline per query (clod::QueryBudget). Pairs reached after the budget is gone are not queried:
+// deadline per query (clod::QueryBudget); the first pair is queried even when the dispatch's own
+// overhead has used the time up, so the round robin always advances. Pairs reached after the budget is gone are not queried:
 // their persistent manifold is refreshed (Bullet's own bookkeeping: points that opened or slid are
 // dropped) and kept, and they rank first next substep. Each pair keeps a clod::CoherenceCache, so an
 // interrupted query resumes next substep from the frontier it reached. The other pairs go through
