@@ -17,12 +17,16 @@ endif()
 if(CLOD_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()
+if(CLOD_BUILD_ENGINES OR CLOD_BUILD_BENCHMARKS)
+  # Bullet 3.24 (libbullet-dev): the clod_bullet plug-in (engines/bullet) and the benchmarks' peer.
+  # Optional: without it the plug-in, its tests and the Bullet rows are skipped.
+  find_package(Bullet QUIET)
+endif()
 if(CLOD_BUILD_BENCHMARKS)
   find_package(benchmark REQUIRED)
   # Peers for side-by-side comparisons; each one is optional.
   find_package(CGAL QUIET)
   find_package(embree 3 QUIET)
   find_package(fcl QUIET)
-  find_package(Bullet QUIET)
   find_package(OpenVDB QUIET PATHS /usr/lib/x86_64-linux-gnu/cmake/OpenVDB)
 endif()

@@ -1,17 +1,18 @@
 #!/usr/bin/env bash
 # Installs the Debian packages clod needs (only the missing ones). Run as root.
 #   scripts/install-deps.sh            build + test dependencies
-#   scripts/install-deps.sh --peers    also the comparison peers used by bench/ (CGAL, Embree, FCL, Bullet, OpenVDB)
+#   scripts/install-deps.sh --peers    also the comparison peers used by bench/ (CGAL, Embree, FCL, OpenVDB; Bullet is a build dependency)
 #   scripts/install-deps.sh --fuzz     also clang and its libFuzzer runtime
 set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config ccache
   libeigen3-dev libassimp-dev libtbb-dev nlohmann-json3-dev libcli11-dev libqhull-dev libxxhash-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libtinygltf-dev gnuplot-nox chromium nodejs
-  libmujoco-dev)  # MuJoCo 2.2.2: the clod_mujoco plug-in and its tests (engines/mujoco)
+  libmujoco-dev  # MuJoCo 2.2.2: the clod_mujoco plug-in and its tests (engines/mujoco)
+  libbullet-dev)  # Bullet 3.24: the clod_bullet plug-in and its tests (engines/bullet, docs/engines.md)
 for arg in "$@"; do
   case "$arg" in
-    --peers) packages+=(libcgal-dev libembree-dev libfcl-dev libbullet-dev libopenvdb-dev) ;;
+    --peers) packages+=(libcgal-dev libembree-dev libfcl-dev libopenvdb-dev) ;;
     --fuzz) packages+=(clang libclang-rt-14-dev) ;;
     *) echo "install-deps.sh: unknown option $arg" >&2; exit 2 ;;
   esac

@@ -20,9 +20,9 @@ ctest --test-dir build -j "$jobs" --output-on-failure
 scripts/test-viewer.sh build/bin/clod  # the web viewer in headless Chromium (docs/viewer.md)
 if [[ "${1:-}" == "--sanitize" ]]; then
   # The library's own tests under the sanitizers; the CLI's end-to-end tests ran in Release above
-  # (CLOD_BUILD_CLI, CMakeLists.txt says why).
+  # (CLOD_BUILD_CLI, CMakeLists.txt says why), and so did the engine plug-ins' (CLOD_BUILD_ENGINES).
   cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCLOD_SANITIZE=ON -DCLOD_BUILD_TESTS=ON \
-    -DCLOD_BUILD_CLI=OFF "${launcher[@]}"
+    -DCLOD_BUILD_CLI=OFF -DCLOD_BUILD_ENGINES=OFF "${launcher[@]}"
   cmake --build build-asan -j "$jobs"
   ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 CLOD_TEST_SCALE=sanitizer \
     ctest --test-dir build-asan -j "$jobs" --output-on-failure

@@ -150,6 +150,17 @@ ScenarioOutcome runScenario(ScenarioKind kind, const ScenarioSettings& settings,
                             const std::filesystem::path& cacheDir,
                             const ScenarioOutcome* reference = nullptr);
 
+/// Judges a run of a scenario's scene that was stepped elsewhere -- another engine running
+/// makeScenario's scene (bench/bullet_compare.cpp runs them in Bullet) -- by the criteria at the
+/// top of this file, with the code runScenario uses. Reads from `outcome`: kind, simulatedSeconds,
+/// finalCenter, speed, maxTiltDeg, maxSinkRel, diverged and `failures` (the caller has already
+/// recorded there how the run diverged or fell through, and set fellThrough). `initialCenter`: the
+/// tracked body's centre of mass at the start; `finalTiltDeg`: its tilt at the end. Sets
+/// displacement, tiltDeg, distance, expectedDistance, error, plausible, and appends the failed
+/// criteria to failures. `reference`: as for runScenario.
+void judgeScenario(ScenarioOutcome& outcome, const Vec3& initialCenter, double finalTiltDeg,
+                   const ScenarioOutcome* reference = nullptr);
+
 /// The budget rule: true when errorAt2N <= errorAtN + max(0.1 errorAtN, 0.002 m). NaN on
 /// either side: false.
 bool degradesMonotonically(double errorAtN, double errorAt2N) noexcept;

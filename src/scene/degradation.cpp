@@ -334,12 +334,19 @@ ScenarioOutcome runScenario(ScenarioKind kind, const ScenarioSettings& settings,
   }
   const RigidBodyState final = world.state(tracked);
   out.finalCenter = centreOfMass(tracked);
-  out.displacement = (out.finalCenter - c0).norm();
-  out.tiltDeg = tiltDeg(q0, final.orientation);
   out.speed = final.velocity.norm();
   if (out.fellThrough) out.failures.push_back(throughMessage);
+  judgeScenario(out, c0, tiltDeg(q0, final.orientation), reference);
+  return out;
+}
 
-  const std::string who = drop ? scene.bodies[tracked].name : isStack(kind) ? "top box" : "box";
+void judgeScenario(ScenarioOutcome& out, const Vec3& c0, double finalTiltDeg, const ScenarioOutcome* reference) {
+  const ScenarioKind kind = out.kind;
+  const bool drop = isDropScenario(kind);
+  const double simulated = out.simulatedSeconds;
+  out.displacement = (out.finalCenter - c0).norm();
+  out.tiltDeg = finalTiltDeg;
+  const std::string who = drop ? std::string(scenarioName(kind)).substr(5) : isStack(kind) ? "top box" : "box";  // as dropBody's name
   auto check = [&](bool ok, const std::string& message) {
     if (!ok) out.failures.push_back(message);
   };
@@ -380,7 +387,6 @@ ScenarioOutcome runScenario(ScenarioKind kind, const ScenarioSettings& settings,
   }
   if (out.diverged) out.error = std::numeric_limits<double>::quiet_NaN();
   out.plausible = out.failures.empty();
-  return out;
 }
 
 }  // namespace clod

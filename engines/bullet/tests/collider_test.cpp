@@ -1,0 +1,435 @@
+// clod_bullet: Bullet's conventions against analytic box-box contacts and Bullet's own box-box
+// algorithm (the peer), a stack of clod-shaped boxes standing in Bullet's world, the per-substep
+// budget, and a non-convex container where the convex hull gives the wrong answer.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include <BulletCollision/CollisionShapes/btConvexHullShape.h>
+#include <BulletCollision/Gimpact/btGImpactCollisionAlgorithm.h>
+#include <BulletCollision/Gimpact/btGImpactShape.h>
+#include <btBulletDynamicsCommon.h>
+
+#include "clod/bake.h"
+#include "clod/bullet/collider.h"
+#include "clod/error.h"
+#include "clod/primitives.h"
+
+namespace {
+
+using clod::Vec3;
+using clod::bullet::Collider;
+using clod::bullet::ColliderSettings;
+using clod::bullet::MeshShape;
+
+std::shared_ptr<const clod::CollisionBody> bakeBody(const clod::TriangleMesh& mesh) {
+  clod::BakeSettings bs;
+  bs.measureFit = false;
+  bs.buildContactTree = false;
+  bs.sphereTree.depth = 3;  // as scenes' boxes (scene.h)
+  return std::make_shared<clod::CollisionBody>(clod::CollisionBody::fromBake(clod::bakeMesh(mesh, bs).contents));
+}
+
+std::shared_ptr<const clod::CollisionBody> boxBody(const Vec3& half) {
+  static std::vector<std::pair<Vec3, std::shared_ptr<const clod::CollisionBody>>> cache;  // bake once per size
+  for (const auto& [h, b] : cache)
+    if (h == half) return b;
+  cache.emplace_back(half, bakeBody(clod::makeBox(half)));
+  return cache.back().second;
+}
+
+btTransform pose(const btVector3& p, const btQuaternion& q = btQuaternion::getIdentity()) { return btTransform(q, p); }
+
+// A collision-only world (no dynamics) with two objects, for contact checks.
+struct PairWorld {
+  btDefaultCollisionConfiguration config;
+  btCollisionDispatcher dispatcher{&config};
+  btDbvtBroadphase broadphase;
+  btCollisionWorld world{&dispatcher, &broadphase, &config};
+  btCollisionObject a, b;
+  PairWorld(btCollisionShape* shapeA, const btTransform& poseA, btCollisionShape* shapeB, const btTransform& poseB) {
+    a.setCollisionShape(shapeA);
+    a.setWorldTransform(poseA);
+    b.setCollisionShape(shapeB);
+    b.setWorldTransform(poseB);
+    world.addCollisionObject(&a);
+    world.addCollisionObject(&b);
+  }
+  ~PairWorld() {
+    world.removeCollisionObject(&b);
+    world.removeCollisionObject(&a);
+  }
+  // The contacts as (normal from b toward a, depth > 0 penetrating, point on b), whatever order
+  // Bullet put the two objects in.
+  struct Point {
+    btVector3 normalBToA, onB;
+    double depth;
+  };
+  std::vector<Point> contacts() {
+    world.performDiscreteCollisionDetection();
+    std::vector<Point> out;
+    for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
+      const btPersistentManifold* man = dispatcher.getManifoldByIndexInternal(m);
+      const bool aIs0 = man->getBody0() == &a;
+      for (int k = 0; k < man->getNumContacts(); ++k) {
+        const btManifoldPoint& p = man->getContactPoint(k);
+        // m_normalWorldOnB points from body1 toward body0.
+        out.push_back({aIs0 ? p.m_normalWorldOnB : -p.m_normalWorldOnB, aIs0 ? p.m_positionWorldOnB : p.m_positionWorldOnA,
+                       -double(p.getDistance())});
+      }
+    }
+    return out;
+  }
+};
+
+// Tolerances for 1 m boxes: btScalar is float (2^-24 relative, ~6e-8 m at 1 m), Bullet
+// recomputes depths from the float points (a few ulps), and clod's cfm depth between two convex
+// polyhedra is exact (docs/narrow-phase.md, "Faceted pairs"); 1e-4 m = 1e-4 of the size leaves
+// three orders of magnitude above float rounding and stays 100x below the 1 cm penetration.
+constexpr double kTol = 1e-4;
+
+class BulletConvention : public ::testing::TestWithParam<clod::ContactModel> {};
+
+TEST_P(BulletConvention, BoxOnBoxGivesNormalOnBAndNegativeDistance) {
+  // A 1 m box A 1 cm into a 1 m box B below it, turned 30 deg about z (face on face).
+  MeshShape shapeA(boxBody(Vec3::Constant(0.5))), shapeB(boxBody(Vec3::Constant(0.5)));
+  const double depth = 0.01;
+  PairWorld w(&shapeA, pose(btVector3(0.1f, -0.05f, btScalar(1.0 - depth)), btQuaternion(btVector3(0, 0, 1), btScalar(M_PI / 6))),
+              &shapeB, pose(btVector3(0, 0, 0)));
+  Collider collider({.model = GetParam()});
+  collider.install(w.world);
+  const auto contacts = w.contacts();
+  ASSERT_GE(contacts.size(), 3u) << "a face-on-face contact needs a support area";
+  for (const auto& c : contacts) {
+    EXPECT_NEAR(c.normalBToA.z(), 1.0, kTol);   // from B (below) up toward A
+    EXPECT_NEAR(c.depth, depth, kTol);          // Bullet's distance = -depth
+    EXPECT_NEAR(c.onB.z(), 0.5, kTol);          // on B's top face
+    const btVector3 onA = c.onB - c.normalBToA * btScalar(c.depth);
+    EXPECT_NEAR(onA.z(), 0.5 - depth, kTol);    // on A's bottom face, inside B
+  }
+  EXPECT_EQ(collider.lastDispatch().pairs, 1u);
+  EXPECT_EQ(collider.lastDispatch().queried, 1u);
+}
+
+TEST_P(BulletConvention, AgreesWithBulletsBoxBoxOnAnEdgeContact) {
+  // A rotated 45 deg about x lies on its edge, 2 cm into B: Bullet's btBoxBoxCollisionAlgorithm is
+  // the peer for normal, depth and where the contact line is.
+  const double depth = 0.02;
+  const btTransform poseA = pose(btVector3(0, 0, btScalar(0.5 + std::sqrt(0.5) - depth)), btQuaternion(btVector3(1, 0, 0), btScalar(M_PI / 4)));
+  const btTransform poseB = pose(btVector3(0, 0, 0));
+  btBoxShape boxA(btVector3(0.5, 0.5, 0.5)), boxB(btVector3(0.5, 0.5, 0.5));
+  std::vector<PairWorld::Point> peer;
+  {
+    PairWorld w(&boxA, poseA, &boxB, poseB);
+    peer = w.contacts();
+  }
+  MeshShape shapeA(boxBody(Vec3::Constant(0.5))), shapeB(boxBody(Vec3::Constant(0.5)));
+  PairWorld w(&shapeA, poseA, &shapeB, poseB);
+  Collider collider({.model = GetParam()});
+  collider.install(w.world);
+  const auto ours = w.contacts();
+  ASSERT_FALSE(peer.empty());
+  ASSERT_FALSE(ours.empty());
+  // The edge contact: every point on the line y = 0, z = 0.5, normal +z, depth 2 cm, in both.
+  for (const std::vector<PairWorld::Point>* set : std::array<const std::vector<PairWorld::Point>*, 2>{&peer, &ours})
+    for (const auto& c : *set) {
+      EXPECT_NEAR(c.normalBToA.z(), 1.0, kTol);
+      EXPECT_NEAR(c.depth, depth, kTol);
+      EXPECT_NEAR(c.onB.y(), 0.0, kTol);
+      EXPECT_NEAR(c.onB.z(), 0.5, kTol);
+    }
+}
+
+TEST_P(BulletConvention, MeshShapeAgainstBtBoxShapeAndSeparatedPairs) {
+  // (MeshShape, btBoxShape) goes through clod too (collideBoxes), both orders; a pair whose
+  // boxes overlap in the broad phase but not in fact gives no contact.
+  MeshShape mesh(boxBody(Vec3::Constant(0.5)));
+  btBoxShape ground(btVector3(2, 2, 0.25));
+  for (bool meshFirst : {true, false}) {
+    PairWorld w = meshFirst ? PairWorld(&mesh, pose(btVector3(0, 0, 0.745f)), &ground, pose(btVector3(0, 0, 0)))
+                            : PairWorld(&ground, pose(btVector3(0, 0, 0)), &mesh, pose(btVector3(0, 0, 0.745f)));
+    Collider collider({.model = GetParam()});
+    collider.install(w.world);
+    const auto contacts = w.contacts();
+    ASSERT_GE(contacts.size(), 3u);
+    for (const auto& c : contacts) {
+      EXPECT_NEAR(std::abs(c.normalBToA.z()), 1.0, kTol);
+      EXPECT_NEAR(c.depth, 0.005, kTol);
+    }
+    EXPECT_EQ(collider.lastDispatch().queried, 1u);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Models, BulletConvention, ::testing::Values(clod::ContactModel::kCfm, clod::ContactModel::kExact),
+                         [](const auto& p) { return std::string(p.param == clod::ContactModel::kCfm ? "cfm" : "exact"); });
+
+TEST(BulletCollider, InstallUninstallRestoresBulletsAlgorithms) {
+  MeshShape a(boxBody(Vec3::Constant(0.5))), b(boxBody(Vec3::Constant(0.5)));
+  PairWorld w(&a, pose(btVector3(0, 0, 0.99f)), &b, pose(btVector3(0, 0, 0)));
+  EXPECT_TRUE(w.contacts().empty()) << "Bullet alone has no algorithm for two concave shapes";
+  {
+    Collider collider;
+    collider.install(w.world);
+    EXPECT_THROW(collider.install(w.world), clod::Error);
+    Collider other;
+    EXPECT_THROW(other.install(w.world), clod::Error);
+    EXPECT_FALSE(w.contacts().empty());
+    collider.uninstall();
+    EXPECT_FALSE(collider.installed());
+    EXPECT_TRUE(w.contacts().empty());
+    EXPECT_EQ(w.dispatcher.getNearCallback(), &btCollisionDispatcher::defaultNearCallback);
+    collider.install(w.world);  // again, then the destructor uninstalls
+    EXPECT_FALSE(w.contacts().empty());
+    EXPECT_THROW(collider.setSettings({.collideBoxes = false}), clod::Error);
+    collider.setSettings({.model = clod::ContactModel::kExact, .budgetTests = 8});
+    EXPECT_FALSE(w.contacts().empty());
+    EXPECT_LE(collider.lastDispatch().tests, 8u);
+  }
+  EXPECT_TRUE(w.contacts().empty());
+}
+
+TEST(BulletCollider, RejectsBadInput) {
+  EXPECT_THROW(MeshShape(nullptr), clod::Error);
+  MeshShape s(boxBody(Vec3::Constant(0.5)));
+  EXPECT_THROW(s.setLocalScaling(btVector3(2, 2, 2)), clod::Error);
+  EXPECT_NO_THROW(s.setLocalScaling(btVector3(1, 1, 1)));
+  EXPECT_THROW(Collider({.maxContacts = 0}), clod::Error);
+  EXPECT_THROW(Collider({.budgetMicros = -1.0}), clod::Error);
+  EXPECT_THROW(Collider({.budgetMicros = NAN}), clod::Error);
+  btVector3 inertia;
+  s.calculateLocalInertia(6, inertia);  // a 1 m cube of 6 kg: m (1 + 1) / 12 = 1 kg m^2 per axis
+  EXPECT_NEAR(inertia.x(), 1.0, 1e-5);
+  EXPECT_NEAR(inertia.z(), 1.0, 1e-5);
+}
+
+// ---- dynamics ----
+
+struct DynWorld {
+  btDefaultCollisionConfiguration config;
+  btCollisionDispatcher dispatcher{&config};
+  btDbvtBroadphase broadphase;
+  btSequentialImpulseConstraintSolver solver;
+  btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &config};
+  std::vector<std::unique_ptr<btCollisionShape>> shapes;
+  std::vector<std::unique_ptr<btDefaultMotionState>> motions;
+  std::vector<std::unique_ptr<btRigidBody>> bodies;
+  DynWorld() {
+    world.setGravity(btVector3(0, 0, -9.81f));
+    world.getSolverInfo().m_numIterations = 20;
+    btGImpactCollisionAlgorithm::registerAlgorithm(&dispatcher);
+  }
+  ~DynWorld() {
+    for (auto& b : bodies) world.removeRigidBody(b.get());
+  }
+  btRigidBody& add(btCollisionShape* shape, double mass, const btTransform& t, double friction) {
+    btVector3 inertia(0, 0, 0);
+    if (mass > 0) shape->calculateLocalInertia(btScalar(mass), inertia);
+    motions.push_back(std::make_unique<btDefaultMotionState>(t));
+    btRigidBody::btRigidBodyConstructionInfo info(btScalar(mass), motions.back().get(), shape, inertia);
+    info.m_friction = btScalar(friction);
+    bodies.push_back(std::make_unique<btRigidBody>(info));
+    bodies.back()->setActivationState(DISABLE_DEACTIVATION);
+    world.addRigidBody(bodies.back().get());
+    return *bodies.back();
+  }
+};
+
+double tiltDeg(const btRigidBody& b) {
+  const btVector3 z = b.getWorldTransform().getBasis().getColumn(2);
+  return std::acos(std::min<btScalar>(1, std::abs(z.z()))) * 180.0 / M_PI;
+}
+
+class BulletStack : public ::testing::TestWithParam<std::uint64_t> {};
+
+TEST_P(BulletStack, FiveClodBoxesStandOnAClodGround) {
+  // issue 17's stack5 (degradation.h) in Bullet's world with clod as the collider: 1 m boxes,
+  // friction 0.6, 60 Hz with 8 substeps (as clod's world runs stacks), 5 s. Criteria as issue 17's:
+  // the top box moves < 2 cm and tilts < 1 deg.
+  DynWorld w;
+  auto ground = std::make_unique<MeshShape>(boxBody(Vec3(2, 2, 0.25)));
+  w.add(ground.get(), 0, pose(btVector3(0, 0, -0.25f)), 0.6);
+  auto box = std::make_unique<MeshShape>(boxBody(Vec3::Constant(0.5)));
+  btRigidBody* top = nullptr;
+  for (int k = 0; k < 5; ++k) top = &w.add(box.get(), 1000, pose(btVector3(0, 0, btScalar(0.5 + k))), 0.6);
+  Collider collider({.model = clod::ContactModel::kCfm, .budgetTests = GetParam()});
+  collider.install(w.world);
+  const btVector3 start = top->getCenterOfMassPosition();
+  std::uint64_t maxTests = 0;
+  for (int step = 0; step < 300; ++step) {
+    w.world.stepSimulation(1.0f / 60, 8, 1.0f / 480);
+    maxTests = std::max(maxTests, collider.lastDispatch().tests);
+    EXPECT_EQ(collider.lastDispatch().pairs, 5u);
+  }
+  const double moved = (top->getCenterOfMassPosition() - start).length();
+  EXPECT_LT(moved, 0.02);
+  EXPECT_LT(tiltDeg(*top), 1.0);
+  if (GetParam() > 0) {
+    EXPECT_LE(maxTests, GetParam());
+  }
+  collider.uninstall();
+}
+
+INSTANTIATE_TEST_SUITE_P(Budgets, BulletStack, ::testing::Values(std::uint64_t(0), std::uint64_t(64)),
+                         [](const auto& p) { return p.param ? "budget" + std::to_string(p.param) : std::string("unlimited"); });
+
+TEST(BulletBudget, SharedAcrossPairsAndStarvedPairsComeFirst) {
+  // Ten boxes resting on the ground: 10 pairs, a budget of 4 tests per substep cannot query them
+  // all; the skipped ones must be queried first in the next substep (round robin), and no substep
+  // spends more than the budget.
+  DynWorld w;
+  auto ground = std::make_unique<MeshShape>(boxBody(Vec3(8, 2, 0.25)));
+  w.add(ground.get(), 0, pose(btVector3(0, 0, -0.25f)), 0.6);
+  auto box = std::make_unique<MeshShape>(boxBody(Vec3::Constant(0.5)));
+  for (int k = 0; k < 10; ++k) w.add(box.get(), 1, pose(btVector3(btScalar(-6.75 + 1.5 * k), 0, 0.499f)), 0.6);
+  Collider collider({.model = clod::ContactModel::kCfm, .budgetTests = 4});
+  collider.install(w.world);
+  std::uint32_t queried = 0, skipped = 0;
+  for (int step = 0; step < 12; ++step) {
+    w.world.stepSimulation(1.0f / 60, 1, 1.0f / 60);
+    const auto& r = collider.lastDispatch();
+    EXPECT_EQ(r.pairs, 10u);
+    EXPECT_LE(r.tests, 4u);
+    queried += r.queried;
+    skipped += r.skipped;
+  }
+  EXPECT_GT(skipped, 0u);
+  EXPECT_GT(queried, 12u);
+  // Nothing fell through although most pairs are skipped in most substeps.
+  for (std::size_t i = 1; i < w.bodies.size(); ++i) EXPECT_GT(w.bodies[i]->getCenterOfMassPosition().z(), 0.45);
+}
+
+TEST(BulletBudget, TimeBudgetSkipsThePairsReachedAfterIt) {
+  // A 1 us budget per substep is gone after the first query (which runs in any case, and makes
+  // at least one batch of tests before it reads the clock): the pairs after it keep their
+  // manifolds, and the starved ones go first next substep. With no time limit every pair is
+  // queried. No timing is asserted (the machine is shared), only which pairs ran.
+  for (double micros : {0.0, 1.0}) {
+    DynWorld w;
+    auto ground = std::make_unique<MeshShape>(boxBody(Vec3(8, 2, 0.25)));
+    w.add(ground.get(), 0, pose(btVector3(0, 0, -0.25f)), 0.6);
+    auto box = std::make_unique<MeshShape>(boxBody(Vec3::Constant(0.5)));
+    for (int k = 0; k < 10; ++k) w.add(box.get(), 1, pose(btVector3(btScalar(-6.75 + 1.5 * k), 0, 0.499f)), 0.6);
+    Collider collider({.model = clod::ContactModel::kCfm, .budgetMicros = micros});
+    collider.install(w.world);
+    std::uint32_t skipped = 0;
+    for (int step = 0; step < 6; ++step) {
+      w.world.stepSimulation(1.0f / 60, 1, 1.0f / 60);
+      EXPECT_EQ(collider.lastDispatch().pairs, 10u);
+      EXPECT_GE(collider.lastDispatch().queried, 1u);
+      skipped += collider.lastDispatch().skipped;
+    }
+    if (micros > 0) {
+      EXPECT_GT(skipped, 0u);
+    } else {
+      EXPECT_EQ(skipped, 0u);
+      for (std::size_t i = 1; i < w.bodies.size(); ++i) EXPECT_GT(w.bodies[i]->getCenterOfMassPosition().z(), 0.45);
+    }
+  }
+}
+
+// ---- a non-convex case ----
+
+// A U-shaped channel as one mesh: a floor slab and two walls (three closed boxes in one mesh, the
+// walls standing beside the floor slab, not on it). Inner gap 1.4 m wide, walls 1 m high.
+clod::TriangleMesh channelMesh() {
+  clod::TriangleMesh out;
+  auto addBox = [&](const Vec3& half, const Vec3& centre) {
+    const clod::TriangleMesh b = clod::makeBox(half);
+    const auto base = std::uint32_t(out.vertices.size());
+    for (const Vec3& v : b.vertices) out.vertices.push_back(v + centre);
+    for (auto t : b.triangles) out.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  };
+  addBox(Vec3(0.7, 1.0, 0.1), Vec3(0, 0, 0.1));     // floor, top at z = 0.2
+  addBox(Vec3(0.1, 1.0, 0.5), Vec3(-0.8, 0, 0.5));  // walls, top at z = 1
+  addBox(Vec3(0.1, 1.0, 0.5), Vec3(0.8, 0, 0.5));
+  return out;
+}
+
+TEST(BulletNonConvex, BoxFallsIntoAChannelWhereTheConvexHullHoldsItOnTop) {
+  // A 1 m box dropped into the channel lands on its floor (centre at z = 0.7) with clod's exact
+  // model and with GImpact (the triangle-level peer); with the channel's convex hull it stays on top
+  // (z >= 1.5). (cfm wedges the box between floor and wall here, 25 deg tilted at z = 0.94:
+  // docs/engines.md, "Limits".)
+  const auto channelBody = bakeBody(channelMesh());
+  auto runWith = [&](int mode, clod::ContactModel model = clod::ContactModel::kCfm) {  // 0 clod, 1 GImpact, 2 convex hull
+    DynWorld w;
+    std::unique_ptr<btCollisionShape> channelShape, boxShape;
+    std::vector<btScalar> verts;
+    std::vector<int> idx;
+    std::vector<std::unique_ptr<btTriangleIndexVertexArray>> arrays;
+    auto gimpact = [&](const clod::TriangleMesh& m, std::vector<btScalar>& v, std::vector<int>& ix) {
+      for (const Vec3& p : m.vertices)
+        for (int k = 0; k < 3; ++k) v.push_back(btScalar(p[k]));
+      for (const auto& t : m.triangles)
+        for (int k = 0; k < 3; ++k) ix.push_back(int(t[k]));
+      arrays.push_back(std::make_unique<btTriangleIndexVertexArray>(int(m.triangles.size()), ix.data(), 3 * int(sizeof(int)),
+                                                                     int(m.vertices.size()), v.data(), 3 * int(sizeof(btScalar))));
+      auto s = std::make_unique<btGImpactMeshShape>(arrays.back().get());
+      s->setMargin(0.001f);
+      s->updateBound();
+      return s;
+    };
+    std::vector<btScalar> boxVerts;
+    std::vector<int> boxIdx;
+    const clod::TriangleMesh boxMesh = clod::makeBox(Vec3::Constant(0.5));
+    if (mode == 0) {
+      channelShape = std::make_unique<MeshShape>(channelBody);
+      boxShape = std::make_unique<MeshShape>(boxBody(Vec3::Constant(0.5)));
+    } else if (mode == 1) {
+      channelShape = gimpact(channelMesh(), verts, idx);
+      boxShape = gimpact(boxMesh, boxVerts, boxIdx);
+    } else {
+      auto hull = std::make_unique<btConvexHullShape>();
+      for (const Vec3& p : channelMesh().vertices) hull->addPoint(btVector3(btScalar(p.x()), btScalar(p.y()), btScalar(p.z())), false);
+      hull->recalcLocalAabb();
+      channelShape = std::move(hull);
+      boxShape = std::make_unique<btBoxShape>(btVector3(0.5, 0.5, 0.5));
+    }
+    w.add(channelShape.get(), 0, pose(btVector3(0, 0, 0)), 0.5);
+    btRigidBody& box = w.add(boxShape.get(), 1, pose(btVector3(0, 0, 2.0f)), 0.5);
+    Collider collider({.model = model});
+    if (mode == 0) collider.install(w.world);
+    for (int step = 0; step < 120; ++step) w.world.stepSimulation(1.0f / 60, 4, 1.0f / 240);
+    collider.uninstall();
+    return double(box.getCenterOfMassPosition().z());
+  };
+  const double clodZ = runWith(0, clod::ContactModel::kExact), gimpactZ = runWith(1), hullZ = runWith(2);
+  // The floor's top is at 0.2: the box's centre rests at 0.7; 1 cm covers resting penetration
+  // (clod's slop is 0.2 % of the diagonal, Bullet's margins 1-4 mm).
+  EXPECT_NEAR(clodZ, 0.7, 0.01);
+  EXPECT_NEAR(gimpactZ, 0.7, 0.01);
+  EXPECT_GT(hullZ, 1.45);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(BulletMeshShape, PrincipalFrameMovesAnOffCentreMeshToItsCentreOfMass) {
+  // A 2 x 1 x 0.5 box whose mesh is centred at (1, 2, 3) and turned 30 deg about z: the principal
+  // frame puts the centre of mass at the origin, and the inertia diagonal in that frame is the
+  // box's principal moments, m (b^2 + c^2) / 12 etc. (analytic; 1e-9 relative covers the mass
+  // integrals' rounding, 1e-5 the float conversion of btVector3).
+  clod::TriangleMesh mesh = clod::makeBox(Vec3(1.0, 0.5, 0.25));
+  const clod::Quat q(Eigen::AngleAxisd(M_PI / 6, Vec3::UnitZ()));
+  for (Vec3& v : mesh.vertices) v = q * v + Vec3(1, 2, 3);
+  const clod::Pose frame = MeshShape::principalFrame(mesh);
+  EXPECT_NEAR(frame.apply(Vec3(1, 2, 3)).norm(), 0.0, 1e-9);
+  MeshShape shape(bakeBody(mesh), frame);
+  const btVector3 mid = 0.5 * (shape.localAabbMin() + shape.localAabbMax());
+  EXPECT_NEAR(mid.length(), 0.0, 1e-5);
+  btVector3 inertia;
+  shape.calculateLocalInertia(12, inertia);
+  std::array<double, 3> got = {inertia.x(), inertia.y(), inertia.z()};
+  std::sort(got.begin(), got.end());
+  EXPECT_NEAR(got[0], 1.0 * 1.0 + 0.5 * 0.5, 1e-5);  // m (b^2 + c^2) / 12 with b = 1, c = 0.5
+  EXPECT_NEAR(got[1], 2.0 * 2.0 + 0.5 * 0.5, 1e-5);
+  EXPECT_NEAR(got[2], 2.0 * 2.0 + 1.0 * 1.0, 1e-5);
+  EXPECT_THROW(MeshShape(bakeBody(mesh), clod::Pose{clod::Quat(2, 0, 0, 0), Vec3::Zero()}), clod::Error);
+}
+
+}  // namespace
