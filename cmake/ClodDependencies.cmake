@@ -11,7 +11,7 @@ pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)  # section checksum
 find_package(TinyGLTF REQUIRED)  # scene.glb export (src/export)
 
 # MuJoCo (Debian's libmujoco-dev 2.2.2) for the clod_mujoco plug-in (engines/mujoco); optional.
-if(CLOD_WITH_MUJOCO AND NOT CLOD_SANITIZE)
+if(CLOD_WITH_MUJOCO AND CLOD_BUILD_ENGINES AND NOT CLOD_SANITIZE)
   find_package(mujoco 2.2 QUIET)
 endif()
 if(CLOD_BUILD_TESTS)
