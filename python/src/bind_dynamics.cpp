@@ -456,6 +456,10 @@ py::dict degradationTable(const std::vector<std::string>& scenarioNames, const s
   };
   {
     py::gil_scoped_release release;
+    // Bake every shape once before the parallel runs (as `clod experiment degradation` does), so
+    // they only read the cache instead of all baking the same shapes at once.
+    for (ScenarioKind kind : kinds)
+      for (ContactModel model : models) buildWorld(makeScenario(kind, settingsOf(kind, model, false, 0, rates[0])), cacheDir);
     tbb::parallel_for(std::size_t(0), references.size(), [&](std::size_t i) {
       references[i].outcome = runScenario(references[i].kind, settingsOf(references[i].kind, ContactModel::kExact, false, 0, references[i].rate), cacheDir);
     });
