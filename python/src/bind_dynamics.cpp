@@ -555,15 +555,15 @@ void bindDynamics(py::module_& mod) {
       .def_readonly("error_bound", &PyQueryResult::errorBound,
                     "(C,) float64: how far the contact may be off (length units; 0 for exact contacts)")
       .def_readonly("budget_used", &PyQueryResult::budgetUsed, "tests made (sphere + triangle), never more than the budget")
-      .def_readonly("sphere_tests", &PyQueryResult::sphereTests)
-      .def_readonly("triangle_tests", &PyQueryResult::triangleTests)
+      .def_readonly("sphere_tests", &PyQueryResult::sphereTests, "sphere-sphere tests of the traversal")
+      .def_readonly("triangle_tests", &PyQueryResult::triangleTests, "triangle-triangle tests (exact model)")
       .def_readonly("finished", &PyQueryResult::finished, "True when the traversal reached the leaves (nothing left to refine)")
-      .def_readonly("colliding", &PyQueryResult::colliding)
+      .def_readonly("colliding", &PyQueryResult::colliding, "the bodies touch as far as the level reached can tell (query.h)")
       .def_readonly("stop", &PyQueryResult::stop, "why it stopped: \"finished\", \"test_budget\" or \"deadline\"")
-      .def_readonly("model", &PyQueryResult::model)
+      .def_readonly("model", &PyQueryResult::model, "the contact model that answered")
       .def_readonly("min_level", &PyQueryResult::minLevel, "shallowest pair level of the answer frontier")
       .def_readonly("max_level", &PyQueryResult::maxLevel, "deepest pair level of the answer frontier")
-      .def_readonly("frontier_pairs", &PyQueryResult::frontierPairs)
+      .def_readonly("frontier_pairs", &PyQueryResult::frontierPairs, "node pairs of the frontier the contacts were built from")
       .def_readonly("raw_contacts", &PyQueryResult::rawContacts, "contacts before the manifold reduction")
       .def_readonly("fallback_pairs", &PyQueryResult::fallbackPairs, "exact model: frontier pairs answered by the cfm/dos fallback")
       .def_readonly("seconds", &PyQueryResult::seconds, "wall-clock seconds of the query")
@@ -604,7 +604,7 @@ void bindDynamics(py::module_& mod) {
       .def_readonly("seconds", &PyBatchResult::seconds, "(P,) float64: each query's wall time")
       .def_readonly("min_level", &PyBatchResult::minLevel, "(P,) uint32")
       .def_readonly("max_level", &PyBatchResult::maxLevel, "(P,) uint32")
-      .def_readonly("model", &PyBatchResult::model)
+      .def_readonly("model", &PyBatchResult::model, "the contact model of the queries")
       .def_readonly("wall_seconds", &PyBatchResult::wallSeconds, "wall time of the parallel queries (no packing)")
       .def("__len__", [](const PyBatchResult& r) { return r.finished.shape(0); })
       .def("__repr__", [](const PyBatchResult& r) {
@@ -619,24 +619,24 @@ void bindDynamics(py::module_& mod) {
         "BatchQueryResult (contacts in CSR form); query i equals clod.query with the i-th poses.");
 
   py::class_<StepReport>(mod, "StepReport", "What one World.step did (world.h StepReport).")
-      .def_readonly("substeps", &StepReport::substeps)
+      .def_readonly("substeps", &StepReport::substeps, "substeps the step took (anti-tunnelling, world.h)")
       .def_readonly("candidate_pairs", &StepReport::candidatePairs, "broad-phase pairs, summed over substeps")
       .def_readonly("tests_spent", &StepReport::testsSpent, "narrow-phase tests, all pairs and substeps")
       .def_readonly("tests_budget", &StepReport::testsBudget, "the step's budget in tests (0 = unlimited)")
       .def_readonly("budget_spent", &StepReport::budgetSpent, "tests + frontier_pair_cost x frontier pairs")
-      .def_readonly("time_budget_micros", &StepReport::timeBudgetMicros)
-      .def_readonly("time_spent_micros", &StepReport::timeSpentMicros)
-      .def_readonly("pairs_skipped", &StepReport::pairsSkipped)
-      .def_readonly("pairs_interrupted", &StepReport::pairsInterrupted)
-      .def_readonly("fallback_pairs", &StepReport::fallbackPairs)
-      .def_readonly("solver_iterations", &StepReport::solverIterations)
-      .def_readonly("cold_restarts", &StepReport::coldRestarts)
-      .def_readonly("narrow_phase_seconds", &StepReport::narrowPhaseSeconds)
-      .def_readonly("solver_seconds", &StepReport::solverSeconds)
-      .def_readonly("broad_phase_seconds", &StepReport::broadPhaseSeconds)
-      .def_readonly("frontier_pairs", &StepReport::frontierPairs)
-      .def_readonly("raw_contacts", &StepReport::rawContacts)
-      .def_readonly("solver_contacts", &StepReport::solverContacts)
+      .def_readonly("time_budget_micros", &StepReport::timeBudgetMicros, "the world's budget_us (0 = no time limit)")
+      .def_readonly("time_spent_micros", &StepReport::timeSpentMicros, "narrow-phase time the time budget counted")
+      .def_readonly("pairs_skipped", &StepReport::pairsSkipped, "pair queries skipped for lack of budget (old contacts kept)")
+      .def_readonly("pairs_interrupted", &StepReport::pairsInterrupted, "queries that stopped before the leaves")
+      .def_readonly("fallback_pairs", &StepReport::fallbackPairs, "exact model: frontier pairs answered by the cfm/dos fallback")
+      .def_readonly("solver_iterations", &StepReport::solverIterations, "velocity iterations, summed over substeps")
+      .def_readonly("cold_restarts", &StepReport::coldRestarts, "substeps whose warm-started solve was redone from zero")
+      .def_readonly("narrow_phase_seconds", &StepReport::narrowPhaseSeconds, "wall seconds in the narrow phase")
+      .def_readonly("solver_seconds", &StepReport::solverSeconds, "wall seconds in the velocity and position solves")
+      .def_readonly("broad_phase_seconds", &StepReport::broadPhaseSeconds, "wall seconds in the broad phase and budget division")
+      .def_readonly("frontier_pairs", &StepReport::frontierPairs, "frontier pairs answered, summed over substeps")
+      .def_readonly("raw_contacts", &StepReport::rawContacts, "contacts before manifold reduction, summed")
+      .def_readonly("solver_contacts", &StepReport::solverContacts, "contacts in the velocity solve, summed")
       .def_readonly("left_bounds", &StepReport::leftBounds, "ids of bodies that left the world's bounds this step")
       .def_property_readonly(
           "contact_pos", [](const StepReport& r) {
@@ -763,7 +763,7 @@ void bindDynamics(py::module_& mod) {
            "budget_spent, substeps, contacts (count), narrow_phase_seconds.")
       .def_readonly("dt", &PyWorld::dt, "default step length (s)")
       .def_readonly("steps", &PyWorld::steps, "the scene's step count (0 for a world built in code)")
-      .def_property_readonly("body_count", [](const PyWorld& self) { return self.world.bodyCount(); })
+      .def_property_readonly("body_count", [](const PyWorld& self) { return self.world.bodyCount(); }, "bodies in the world (ids 0 .. n-1)")
       .def_property_readonly(
           "names", [](const PyWorld& self) {
             std::vector<std::string> names;
@@ -811,8 +811,9 @@ void bindDynamics(py::module_& mod) {
            "Changes the contact model between steps (the model's data must be in the bodies' bakes).")
       .def("set_budget", [](PyWorld& self, std::uint64_t tests) { self.world.setBudgetTests(tests); }, py::arg("tests"),
            "Changes the tests-per-step budget between steps (0 = unlimited).")
-      .def_property_readonly("model", [](const PyWorld& self) { return std::string(contactModelName(self.world.settings().model)); })
-      .def_property_readonly("budget", [](const PyWorld& self) { return self.world.settings().budgetTests; })
+      .def_property_readonly("model", [](const PyWorld& self) { return std::string(contactModelName(self.world.settings().model)); },
+                             "the contact model of every pair")
+      .def_property_readonly("budget", [](const PyWorld& self) { return self.world.settings().budgetTests; }, "tests per step (0 = unlimited)")
       .def("__repr__", [](const PyWorld& self) {
         return "<clod.World " + std::to_string(self.world.bodyCount()) + " bodies, model " +
                std::string(contactModelName(self.world.settings().model)) + ">";

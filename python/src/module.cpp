@@ -601,8 +601,8 @@ void bindCore(py::module_& mod) {
                                 {py::ssize_t(m.mesh->triangleCount()), 3}, self);
           },
           "(M, 3) uint32 vertex indices, read-only view")
-      .def_property_readonly("vertex_count", [](const PyMesh& m) { return m.mesh->vertexCount(); })
-      .def_property_readonly("triangle_count", [](const PyMesh& m) { return m.mesh->triangleCount(); })
+      .def_property_readonly("vertex_count", [](const PyMesh& m) { return m.mesh->vertexCount(); }, "N, the number of vertices")
+      .def_property_readonly("triangle_count", [](const PyMesh& m) { return m.mesh->triangleCount(); }, "M, the number of triangles")
       .def_property_readonly(
           "bounds", [](const PyMesh& m) {
             const Aabb box = m.mesh->bounds();
@@ -694,12 +694,14 @@ void bindCore(py::module_& mod) {
           "mesh", [](const PyBake& b) { return makePyMesh(b.contents->mesh, validateMesh(b.contents->mesh)); },
           "the baked mesh (a new clod.Mesh each time)")
       .def_property_readonly("mesh_hash", [](const PyBake& b) { return b.contents->meshHash; }, "XXH3-64 content hash of the mesh")
-      .def_property_readonly("source_name", [](const PyBake& b) { return b.contents->sourceName; })
-      .def_property_readonly("sphere_count", [](const PyBake& b) { return b.contents->sphereTree.sphereCount(); })
+      .def_property_readonly("source_name", [](const PyBake& b) { return b.contents->sourceName; }, "where the mesh came from (its file name), may be empty")
+      .def_property_readonly("sphere_count", [](const PyBake& b) { return b.contents->sphereTree.sphereCount(); }, "spheres on all levels")
       .def_property_readonly("level_count", [](const PyBake& b) { return b.contents->sphereTree.levelCount(); },
                              "sphere-tree levels, root included")
-      .def_property_readonly("has_closest_feature_map", [](const PyBake& b) { return b.contents->closestFeatureMap.has_value(); })
-      .def_property_readonly("has_contact_tree", [](const PyBake& b) { return b.contents->contactTree.has_value(); })
+      .def_property_readonly("has_closest_feature_map", [](const PyBake& b) { return b.contents->closestFeatureMap.has_value(); },
+                             "True when the bake has closest feature maps (the cfm and average models need them)")
+      .def_property_readonly("has_contact_tree", [](const PyBake& b) { return b.contents->contactTree.has_value(); },
+                             "True when the bake has a contact tree (the contact-tree model needs it)")
       .def_property_readonly("diagonal", [](const PyBake& b) { return b.body->diagonal(); }, "bounding-box diagonal of the mesh")
       .def("spheres", &bakeSpheres, py::arg("level") = -1,
            "(centers (n, 3), radii (n,)) of one sphere-tree level (root = 0), or of every sphere (level=-1,\n"
