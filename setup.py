@@ -21,6 +21,7 @@ from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 ROOT = os.path.dirname(os.path.abspath(__file__))
+os.makedirs(os.path.join(ROOT, "build-python"), exist_ok=True)  # setup.cfg puts setuptools' scratch there
 with open(os.path.join(ROOT, "CMakeLists.txt"), encoding="utf-8") as cmake_lists:
     VERSION = re.search(r"project\(clod VERSION ([0-9.]+)", cmake_lists.read()).group(1)
 

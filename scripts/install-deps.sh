@@ -7,7 +7,9 @@ set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config ccache
   libeigen3-dev libassimp-dev libtbb-dev nlohmann-json3-dev libcli11-dev libqhull-dev libxxhash-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libtinygltf-dev gnuplot-nox chromium nodejs)
+  libtinygltf-dev gnuplot-nox chromium nodejs
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-dask python3-distributed python3-matplotlib
+  python3-venv python3-pip python3-setuptools python3-wheel)
 for arg in "$@"; do
   case "$arg" in
     --peers) packages+=(libcgal-dev libembree-dev libfcl-dev libbullet-dev libopenvdb-dev) ;;
