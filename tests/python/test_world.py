@@ -90,7 +90,7 @@ def test_scene_and_world_errors_carry_codes(tmp_path):
     world = clod.World()
     with pytest.raises(clod.InvalidArgumentError):
         world.step(-1.0)
-    box = clod.bake(clod.Mesh.box([1, 1, 1]), sphere_tree="octree", levels=1, measure_fit=False)
+    box = clod.bake(clod.Mesh.box([1, 1, 1]), sphere_tree="octree", levels=1, contact_tree=False, measure_fit=False)
     for kwargs in (dict(position=[0, 0]), dict(orientation=[0, 0, 0, 0]), dict(velocity=[np.nan, 0, 0]),
                    dict(type="floating"), dict(mass=-1.0), dict(friction=-1.0)):
         with pytest.raises(clod.InvalidArgumentError):
