@@ -29,27 +29,28 @@ const char* stopName(QueryStop stop) {
 }
 
 /// QuerySettings from the keyword arguments shared by query and query_batch.
-QuerySettings querySettings(const std::string& model, const py::object& budget, std::uint32_t maxContacts, const py::object& maxLevel) {
+QuerySettings querySettings(const std::string& model, std::optional<long long> budget, std::uint32_t maxContacts,
+                            std::optional<long long> maxLevel) {
   QuerySettings settings;
   settings.model = parseContactModel(model);
-  if (!budget.is_none()) {
-    const long long tests = budget.cast<long long>();
+  if (budget) {
+    const long long tests = *budget;
     if (tests < 1) invalidArgument("budget: at least 1 test (None for unlimited), got " + std::to_string(tests));
     settings.budget.maxTests = static_cast<std::uint64_t>(tests);
   }
   if (maxContacts < 1 || maxContacts > 1024) invalidArgument("max_contacts: must be 1..1024, got " + std::to_string(maxContacts));
   settings.maxContacts = maxContacts;
-  if (!maxLevel.is_none()) {
-    const long long level = maxLevel.cast<long long>();
+  if (maxLevel) {
+    const long long level = *maxLevel;
     if (level < 0) invalidArgument("max_level: must be >= 0 (None for no cap), got " + std::to_string(level));
     settings.maxLevel = static_cast<std::uint32_t>(std::min<long long>(level, UINT32_MAX));
   }
   return settings;
 }
 
-std::optional<double> deadlineMicros(const py::object& deadlineUs) {
-  if (deadlineUs.is_none()) return std::nullopt;
-  const double us = deadlineUs.cast<double>();
+std::optional<double> deadlineMicros(std::optional<double> deadlineUs) {
+  if (!deadlineUs) return std::nullopt;
+  const double us = *deadlineUs;
   if (!std::isfinite(us) || us < 0.0) invalidArgument("deadline_us: must be finite and >= 0 (None for no deadline)");
   return us;
 }
@@ -107,8 +108,9 @@ PyQueryResult packQueryResult(const QueryResult& r, ContactModel model) {
   return out;
 }
 
-PyQueryResult runQuery(const PyBake& a, py::handle poseA, const PyBake& b, py::handle poseB, const std::string& model,
-                       const py::object& budget, const py::object& deadlineUs, std::uint32_t maxContacts, const py::object& maxLevel) {
+PyQueryResult runQuery(const PyBake& a, const ArrayLike& poseA, const PyBake& b, const ArrayLike& poseB, const std::string& model,
+                       std::optional<long long> budget, std::optional<double> deadlineUs, std::uint32_t maxContacts,
+                       std::optional<long long> maxLevel) {
   QuerySettings settings = querySettings(model, budget, maxContacts, maxLevel);
   const Pose xfA = parsePose(poseA, "pose_a");
   const Pose xfB = parsePose(poseB, "pose_b");
@@ -134,9 +136,9 @@ struct PyBatchResult {
   double wallSeconds = 0.0;
 };
 
-PyBatchResult runQueryBatch(const PyBake& a, py::handle posesAObj, const PyBake& b, py::handle posesBObj, const std::string& model,
-                            const py::object& budget, const py::object& deadlineUs, std::uint32_t maxContacts,
-                            const py::object& maxLevel) {
+PyBatchResult runQueryBatch(const PyBake& a, const ArrayLike& posesAObj, const PyBake& b, const ArrayLike& posesBObj,
+                            const std::string& model, std::optional<long long> budget, std::optional<double> deadlineUs,
+                            std::uint32_t maxContacts, std::optional<long long> maxLevel) {
   const QuerySettings settings = querySettings(model, budget, maxContacts, maxLevel);
   const std::vector<Pose> posesA = parsePoses(posesAObj, "poses_a");
   const std::vector<Pose> posesB = parsePoses(posesBObj, "poses_b");
@@ -241,7 +243,7 @@ const char* bodyTypeName(BodyType type) {
   return "unknown";
 }
 
-std::unique_ptr<PyWorld> makeWorld(py::handle gravity, const std::string& model, std::uint64_t budget, double budgetUs, double dt,
+std::unique_ptr<PyWorld> makeWorld(const ArrayLike& gravity, const std::string& model, std::uint64_t budget, double budgetUs, double dt,
                                    std::uint32_t maxContacts, std::uint32_t minSubsteps, std::uint32_t maxSubsteps,
                                    std::uint32_t velocityIterations, std::uint32_t positionIterations, std::uint32_t frontierPairCost,
                                    double restitutionThreshold) {
@@ -264,15 +266,16 @@ std::unique_ptr<PyWorld> makeWorld(py::handle gravity, const std::string& model,
   return w;
 }
 
-std::unique_ptr<PyWorld> worldFromScene(SceneDescription scene, const py::object& model, const py::object& budget,
-                                        const py::object& budgetUs, const std::string& cacheDir) {
-  if (!model.is_none()) scene.world.model = parseContactModel(model.cast<std::string>());
-  if (!budget.is_none()) {
-    const long long tests = budget.cast<long long>();
+std::unique_ptr<PyWorld> worldFromScene(SceneDescription scene, const std::optional<std::string>& model,
+                                        std::optional<long long> budget, std::optional<double> budgetUs,
+                                        const std::string& cacheDir) {
+  if (model) scene.world.model = parseContactModel(*model);
+  if (budget) {
+    const long long tests = *budget;
     if (tests < 0) invalidArgument("budget: tests per step, >= 0 (0 = unlimited)");
     scene.world.budgetTests = static_cast<std::uint64_t>(tests);
   }
-  if (!budgetUs.is_none()) scene.world.budgetMicros = budgetUs.cast<double>();
+  if (budgetUs) scene.world.budgetMicros = *budgetUs;
   std::unique_ptr<PyWorld> result;
   {
     py::gil_scoped_release release;
@@ -283,8 +286,9 @@ std::unique_ptr<PyWorld> worldFromScene(SceneDescription scene, const py::object
   return result;
 }
 
-BodyId addBody(PyWorld& w, const PyBake& shape, const py::object& mass, double density, const std::string& type, py::handle position,
-               py::handle orientation, py::handle velocity, py::handle angularVelocity, double restitution, double friction,
+BodyId addBody(PyWorld& w, const PyBake& shape, std::optional<double> mass, double density, const std::string& type,
+               const ArrayLike& position, const ArrayLike& orientation, const ArrayLike& velocity,
+               const ArrayLike& angularVelocity, double restitution, double friction,
                const std::string& name) {
   RigidBodyDesc desc;
   desc.name = name.empty() ? "body " + std::to_string(w.world.bodyCount()) : name;
@@ -303,8 +307,8 @@ BodyId addBody(PyWorld& w, const PyBake& shape, const py::object& mass, double d
   if (desc.type == BodyType::kDynamic) {
     if (!std::isfinite(density) || !(density > 0.0)) invalidArgument("density: must be finite and > 0");
     MassProperties p = computeMassPropertiesOrBoundingBox(shape.contents->mesh, density);
-    if (!mass.is_none()) {
-      const double m = mass.cast<double>();
+    if (mass) {
+      const double m = *mass;
       if (!std::isfinite(m) || !(m > 0.0)) invalidArgument("mass: must be finite and > 0");
       p.inertia *= m / p.mass;
       p.mass = m;
@@ -335,10 +339,10 @@ void putOrientation(const RigidBodyState& s, double* out) {
 }
 
 /// World.run: `steps` steps with the GIL released, recording states and per-step counters.
-py::dict runWorld(PyWorld& w, const py::object& stepsObj, const py::object& dtObj) {
-  const long long steps = stepsObj.is_none() ? static_cast<long long>(w.steps) : stepsObj.cast<long long>();
+py::dict runWorld(PyWorld& w, std::optional<long long> stepsArg, std::optional<double> dtArg) {
+  const long long steps = stepsArg ? *stepsArg : static_cast<long long>(w.steps);
   if (steps < 0) invalidArgument("steps: must be >= 0");
-  const double dt = dtObj.is_none() ? w.dt : dtObj.cast<double>();
+  const double dt = dtArg ? *dtArg : w.dt;
   if (!std::isfinite(dt) || !(dt > 0.0)) invalidArgument("dt: must be finite and > 0");
   const std::size_t n = w.world.bodyCount();
   const std::size_t s = static_cast<std::size_t>(steps);
@@ -717,8 +721,8 @@ void bindDynamics(py::module_& mod) {
            "(0 = none; not repeatable bit for bit); dt: the default step length of step() and run().\n"
            "Out-of-range settings raise clod.InvalidArgumentError naming the setting.")
       .def_static(
-          "from_scene", [](const std::string& path, const py::object& model, const py::object& budget, const py::object& budgetUs,
-                           const std::string& cacheDir) {
+          "from_scene", [](const std::string& path, const std::optional<std::string>& model, std::optional<long long> budget,
+                           std::optional<double> budgetUs, const std::string& cacheDir) {
             SceneDescription scene;
             {
               py::gil_scoped_release release;
@@ -732,8 +736,8 @@ void bindDynamics(py::module_& mod) {
           "(cached in cache_dir when given), bodies added in scene order. model / budget / budget_us override\n"
           "the scene's. dt and steps come from the scene. Raises clod.Error(scene_error) naming the key path.")
       .def_static(
-          "from_json", [](const std::string& text, const std::string& baseDir, const py::object& model, const py::object& budget,
-                          const py::object& budgetUs, const std::string& cacheDir) {
+          "from_json", [](const std::string& text, const std::string& baseDir, const std::optional<std::string>& model,
+                          std::optional<long long> budget, std::optional<double> budgetUs, const std::string& cacheDir) {
             return worldFromScene(parseScene(text, baseDir, "scene"), model, budget, budgetUs, cacheDir);
           },
           py::arg("text"), py::arg("base_dir") = ".", py::kw_only(), py::arg("model") = py::none(), py::arg("budget") = py::none(),
@@ -749,8 +753,8 @@ void bindDynamics(py::module_& mod) {
            "its bounding box's); `mass` rescales them. position: where the mesh origin goes; orientation (w, x, y, z);\n"
            "velocity of the centre of mass; angular_velocity in the world frame (rad/s).")
       .def(
-          "step", [](PyWorld& self, const py::object& dt) {
-            const double h = dt.is_none() ? self.dt : dt.cast<double>();
+          "step", [](PyWorld& self, std::optional<double> dt) {
+            const double h = dt ? *dt : self.dt;
             py::gil_scoped_release release;
             return StepReport(self.world.step(h));
           },

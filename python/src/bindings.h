@@ -33,6 +33,14 @@ namespace clod::python {
 
 namespace py = pybind11;
 
+/// An array argument as the caller passed it (an ndarray, a list, a tuple...): the bindings check
+/// and convert it themselves (toDoubleArray, requirePoints, parsePose). Its own type caster only
+/// gives signatures a readable name, so help() shows "numpy.typing.ArrayLike", not "handle".
+struct ArrayLike {
+  py::object value;
+  operator py::handle() const { return value; }
+};
+
 /// A C-contiguous float64 NumPy array (what every numeric argument is converted to).
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
@@ -112,3 +120,15 @@ void bindCore(py::module_& m);
 void bindDynamics(py::module_& m);
 
 }  // namespace clod::python
+
+namespace pybind11::detail {
+template <>
+struct type_caster<clod::python::ArrayLike> {
+  PYBIND11_TYPE_CASTER(clod::python::ArrayLike, const_name("numpy.typing.ArrayLike"));
+  bool load(handle source, bool) {
+    value.value = reinterpret_borrow<object>(source);
+    return true;
+  }
+  static handle cast(const clod::python::ArrayLike& array, return_value_policy, handle) { return array.value.inc_ref(); }
+};
+}  // namespace pybind11::detail

@@ -336,7 +336,7 @@ struct ClosestResult {
   std::string signMethod;
 };
 
-ClosestResult closestPoints(const PyMesh& m, py::handle pointsObj, const std::string& sign) {
+ClosestResult closestPoints(const PyMesh& m, const ArrayLike& pointsObj, const std::string& sign) {
   if (sign != "auto" && sign != "winding_number") invalidArgument("sign: expected \"auto\" or \"winding_number\", got \"" + sign + "\"");
   const DoubleArray points = requirePoints(pointsObj, "points");
   const std::size_t n = static_cast<std::size_t>(points.shape(0));
@@ -561,7 +561,7 @@ void bindCore(py::module_& mod) {
       "faces (M, 3) of integer vertex indices. The mesh is validated: NaN/Inf vertices, indices out of range,\n"
       "no triangles or only zero-area ones raise clod.Error with the matching code; open, non-manifold or\n"
       "degenerate-containing meshes are accepted (see inspect()). Mesh.load(path) reads a file.");
-  meshClass.def(py::init([](py::handle vertices, py::handle faces) { return meshFromArrays(vertices, faces); }), py::arg("vertices"),
+  meshClass.def(py::init([](const ArrayLike& vertices, const ArrayLike& faces) { return meshFromArrays(vertices, faces); }), py::arg("vertices"),
            py::arg("faces"))
       .def_static("load", &loadPyMesh, py::arg("path"), py::arg("weld_tolerance_rel") = MeshLoadOptions{}.weldToleranceRel,
                   py::arg("orient_outward") = MeshLoadOptions{}.orientOutward,
@@ -571,7 +571,7 @@ void bindCore(py::module_& mod) {
                   "(unknown_format, parse_error, non_finite_vertex, index_out_of_range, no_triangles, ...).\n"
                   "Non-fatal findings are in inspect()[\"warnings\"]. Releases the GIL.")
       .def_static(
-          "box", [](py::handle half) {
+          "box", [](const ArrayLike& half) {
             DoubleArray h = toDoubleArray(half, "half_extents");
             if (h.size() != 3) invalidArgument("half_extents: expected 3 numbers, got shape " + shapeText(h));
             TriangleMesh box = makeBox(Vec3(h.data()[0], h.data()[1], h.data()[2]));

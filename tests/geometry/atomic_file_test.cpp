@@ -84,7 +84,7 @@ TEST_F(AtomicFile, ThreadsWritingTheSameTargetEachRenameTheirOwnFile) {
   std::vector<std::thread> threads;
   for (int t = 0; t < 4; ++t) {
     threads.emplace_back([&] {
-      for (int i = 0; i < 50; ++i) {
+      for (int i = 0; i < 25; ++i) {
         try {
           writeFileAtomically(target, content);
         } catch (const Error&) {
