@@ -3,7 +3,7 @@
 # tables and the exact command that produced every figure).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-pages=(proximity sphere_tree bake sampling cfm contact_tree sdfbake narrowphase world engines)
+pages=(proximity sphere_tree bake sampling cfm contact_tree sdfbake narrowphase world engines python)
 {
   echo "# Benchmarks"
   echo

@@ -9,7 +9,9 @@ packages=(build-essential cmake ninja-build pkg-config ccache
   libgtest-dev libgmock-dev libbenchmark-dev
   libtinygltf-dev gnuplot-nox chromium nodejs
   libmujoco-dev  # MuJoCo 2.2.2: the clod_mujoco plug-in and its tests (engines/mujoco)
-  libbullet-dev)  # Bullet 3.24: the clod_bullet plug-in and its tests (engines/bullet, docs/engines.md)
+  libbullet-dev  # Bullet 3.24: the clod_bullet plug-in and its tests (engines/bullet, docs/engines.md)
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-dask python3-distributed python3-matplotlib
+  python3-venv python3-pip python3-setuptools python3-wheel)
 for arg in "$@"; do
   case "$arg" in
     --peers) packages+=(libcgal-dev libembree-dev libfcl-dev libopenvdb-dev) ;;

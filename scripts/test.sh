@@ -14,9 +14,19 @@ if command -v ccache >/dev/null 2>&1; then
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
   export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$PWD}"
 fi
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCLOD_BUILD_TESTS=ON "${launcher[@]}"
+# The Python package (python/, docs/python.md) is built in this Release pass only: Debian's
+# interpreter, whose python3-numpy it uses (a pyenv or conda python3 may come first on PATH).
+python="$(realpath "${CLOD_PYTHON:-/usr/bin/python3}")"
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCLOD_BUILD_TESTS=ON \
+  -DCLOD_BUILD_PYTHON=ON -DPython_EXECUTABLE="$python" "${launcher[@]}"
 cmake --build build -j "$jobs"
-ctest --test-dir build -j "$jobs" --output-on-failure
+ctest --test-dir build -j "$jobs" --output-on-failure  # includes python/pytest (tests/python)
+# The README's one-command install of the Python package, into a throwaway virtual environment,
+# reusing build/ (only the module's target is checked); then `import clod` from another directory.
+rm -rf build/venv
+"$python" -m venv --system-site-packages build/venv
+CLOD_CMAKE_BUILD_DIR="$PWD/build" build/venv/bin/pip install -q --no-build-isolation .
+(cd / && "$OLDPWD/build/venv/bin/python" -c 'import clod; print("python: import clod", clod.__version__, "from", clod.__file__)')
 scripts/test-viewer.sh build/bin/clod  # the web viewer in headless Chromium (docs/viewer.md)
 if [[ "${1:-}" == "--sanitize" ]]; then
   # The library's own tests under the sanitizers; the CLI's end-to-end tests ran in Release above

@@ -1,5 +1,7 @@
 #include "clod/atomic_file.h"
 
+#include <atomic>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <unistd.h>
@@ -32,8 +34,11 @@ void writeFileAtomically(const std::filesystem::path& path, std::string_view con
     throw Error(ErrorCode::kFileWriteFailed, "refusing to replace '" + path.string() + "': it is " +
                                                  fileTypeName(status.type()) + ", not a regular file");
   }
+  // A temporary name of its own per call: two threads writing the same target (parallel scene
+  // builds sharing a bake cache) each rename their own complete file into place.
+  static std::atomic<std::uint64_t> writeCount{0};
   std::filesystem::path temp = path;
-  temp += ".tmp." + std::to_string(::getpid());
+  temp += ".tmp." + std::to_string(::getpid()) + "." + std::to_string(writeCount.fetch_add(1));
   std::FILE* file = std::fopen(temp.c_str(), "wb");
   if (!file) throw Error(ErrorCode::kFileWriteFailed, "cannot open '" + temp.string() + "' for writing");
   const bool written = std::fwrite(content.data(), 1, content.size(), file) == content.size() &&
@@ -46,7 +51,8 @@ void writeFileAtomically(const std::filesystem::path& path, std::string_view con
   }
   std::filesystem::rename(temp, path, ec);
   if (ec) {
-    std::filesystem::remove(temp, ec);
+    std::error_code removeError;
+    std::filesystem::remove(temp, removeError);
     throw Error(ErrorCode::kFileWriteFailed, "cannot rename into '" + path.string() + "': " + ec.message());
   }
 }

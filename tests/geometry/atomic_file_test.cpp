@@ -4,9 +4,12 @@
 #include <sys/sysmacros.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -69,6 +72,31 @@ TEST_F(AtomicFile, RefusesToReplaceADevice) {
   if (::mknod(device.c_str(), S_IFCHR | 0666, makedev(1, 7)) != 0) GTEST_SKIP() << "cannot make a device node";
   EXPECT_NE(writeError(device).find("it is a character device"), std::string::npos);
   EXPECT_TRUE(fs::is_character_file(device));
+}
+
+TEST_F(AtomicFile, ThreadsWritingTheSameTargetEachRenameTheirOwnFile) {
+  // Parallel scene builds sharing a bake cache write the same file from several threads of one
+  // process; the temporary name was the process id only, so one thread renamed the other's
+  // half-written file or found its own gone ("cannot rename into ...").
+  const fs::path target = dir_ / "shared";
+  const std::string content(1 << 16, 'x');
+  std::atomic<int> failures{0};
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t) {
+    threads.emplace_back([&] {
+      for (int i = 0; i < 25; ++i) {
+        try {
+          writeFileAtomically(target, content);
+        } catch (const Error&) {
+          ++failures;
+        }
+      }
+    });
+  }
+  for (std::thread& thread : threads) thread.join();
+  EXPECT_EQ(failures.load(), 0);
+  EXPECT_EQ(readWholeFile(target), content);
+  EXPECT_EQ(entries(), 1u) << "no temporary file left behind";
 }
 
 }  // namespace
