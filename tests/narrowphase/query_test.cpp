@@ -176,8 +176,12 @@ TEST(NarrowPhaseCubeOnCube, ContactTreeAndExactGiveTheFaceNormalAtFullBudget) {
         // Contacts lie in the overlap of the two faces, at the contact plane z = 1, within the
         // penetration (exact) or the contact tree's field error (2e-3 of the diagonal each).
         EXPECT_NEAR(c.point.z(), 1.0, 0.05) << contactModelName(model);
-        EXPECT_LE(std::abs(c.point.x()), 1.0 + 1e-6);
-        EXPECT_LE(std::abs(c.point.x() - offset.x()), 1.0 + 1e-6);
+        // Across the faces: exact to rounding; contact-tree samples of inner cells are moved
+        // onto the zero level of the interpolated field, stopping within twice the field's
+        // error (projectOntoSurface), so they may lie that far past an edge.
+        const double across = model == ContactModel::kExact ? 1e-6 : 2.0 * b.cubeA.contactTree().errorAbs;
+        EXPECT_LE(std::abs(c.point.x()), 1.0 + across);
+        EXPECT_LE(std::abs(c.point.x() - offset.x()), 1.0 + across);
       }
     }
   }
