@@ -47,6 +47,7 @@
 
 #include "clod/bullet/collider.h"
 #include "clod/degradation.h"
+#include "bench_args.h"
 #include "clod/error.h"
 #include "clod/scene.h"
 #include "clod/world.h"
@@ -68,33 +69,10 @@ struct Options {
   double gimpactMargin = 0.004;
 };
 
-struct UsageError {
-  std::string message;
-};
-
-std::vector<std::string> splitList(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
-std::uint64_t parseCount(const std::string& flag, const std::string& text) {
-  if (text == "unlimited") return 0;
-  char* end = nullptr;
-  const unsigned long long v = std::strtoull(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0' || text[0] == '-') throw UsageError{flag + ": expected a count, got '" + text + "'"};
-  return v;
-}
-
-double parsePositive(const std::string& flag, const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || !(v >= 0.0) || !std::isfinite(v)) throw UsageError{flag + ": expected a number >= 0"};
-  return v;
-}
+using bench::parseCount;
+using bench::splitList;
+using bench::UsageError;
+using bench::parsePositive;
 
 Options parseOptions(int argc, char** argv) {
   Options o;

@@ -58,6 +58,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "bench_args.h"
 #include "clod/error.h"
 #include "clod/scene.h"
 #include "clod/world.h"
@@ -91,26 +92,9 @@ struct Options {
   std::optional<std::uint32_t> frontierCost, minSubstepIterations;
 };
 
-struct UsageError {
-  std::string message;
-};
-
-std::vector<std::string> splitList(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
-std::uint64_t parseCount(const std::string& flag, const std::string& text) {
-  if (text == "unlimited") return 0;
-  char* end = nullptr;
-  const unsigned long long v = std::strtoull(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0' || text[0] == '-') throw UsageError{flag + ": expected a count, got '" + text + "'"};
-  return v;
-}
+using bench::parseCount;
+using bench::splitList;
+using bench::UsageError;
 
 Options parseOptions(int argc, char** argv) {
   Options o;

@@ -23,6 +23,20 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// Adds one step's counts to running totals; the time is the later step's.
+void accumulate(StepStats& t, const StepStats& c) {
+  t.time = c.time;
+  t.pairs += c.pairs;
+  t.pairsSkipped += c.pairsSkipped;
+  t.pairsInterrupted += c.pairsInterrupted;
+  t.pairsFallback += c.pairsFallback;
+  t.testsSpent += c.testsSpent;
+  t.budgetSpent += c.budgetSpent;
+  t.testsBudget += c.testsBudget;
+  t.contacts += c.contacts;
+  t.seconds += c.seconds;
+}
+
 // A contact kept for a pair the budget skips later: each surface point anchored in its own
 // geom, the normal (geom1 -> geom2) in geom1's frame (docs/engines-mujoco.md).
 struct Anchor {
@@ -194,17 +208,7 @@ void Collider::Impl::finishStep(DataState& ds) {
   ds.calledThisStep.clear();
   ds.last = c;
   ds.hasLast = true;
-  StepStats& t = ds.totals;
-  t.time = c.time;
-  t.pairs += c.pairs;
-  t.pairsSkipped += c.pairsSkipped;
-  t.pairsInterrupted += c.pairsInterrupted;
-  t.pairsFallback += c.pairsFallback;
-  t.testsSpent += c.testsSpent;
-  t.budgetSpent += c.budgetSpent;
-  t.testsBudget += c.testsBudget;
-  t.contacts += c.contacts;
-  t.seconds += c.seconds;
+  accumulate(ds.totals, c);
 }
 
 // World's division (world.h), planned at the first call of a step from the pairs the previous
@@ -451,17 +455,7 @@ StepStats Collider::totals(const mjData* d) const {
   auto it = impl_->data.find(d);
   if (it == impl_->data.end()) return {};
   StepStats t = it->second.totals;  // finished steps, plus the one in progress
-  const StepStats& c = it->second.current;
-  t.time = c.time;
-  t.pairs += c.pairs;
-  t.pairsSkipped += c.pairsSkipped;
-  t.pairsInterrupted += c.pairsInterrupted;
-  t.pairsFallback += c.pairsFallback;
-  t.testsSpent += c.testsSpent;
-  t.budgetSpent += c.budgetSpent;
-  t.testsBudget += c.testsBudget;
-  t.contacts += c.contacts;
-  t.seconds += c.seconds;
+  accumulate(t, it->second.current);
   return t;
 }
 
