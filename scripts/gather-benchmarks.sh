@@ -3,7 +3,7 @@
 # tables and the exact command that produced every figure).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-pages=(proximity sphere_tree bake sampling cfm contact_tree sdfbake narrowphase world engines python)
+pages=(proximity sphere_tree bake sampling cfm contact_tree sdfbake narrowphase degradation world engines python)
 {
   echo "# Benchmarks"
   echo
@@ -20,7 +20,8 @@ pages=(proximity sphere_tree bake sampling cfm contact_tree sdfbake narrowphase 
     # Demote headings one level so each page becomes a section (not `#` lines inside fenced
     # code blocks: shell comments); relative image links are rewritten to point into
     # docs/benchmarks/ from the repository root.
-    awk '/^```/ { fenced = !fenced } !fenced && /^#/ { $0 = "#" $0 } { print }' "$f" |
+    # A page's "## History" (dated earlier runs) stays on the page: BENCHMARKS.md is the current summary.
+    awk '/^```/ { fenced = !fenced } !fenced && /^## History/ { exit } !fenced && /^#/ { $0 = "#" $0 } { print }' "$f" |
       sed -e 's/](\([A-Za-z0-9_.-]*\.\(png\|svg\)\))/](docs\/benchmarks\/\1)/g'
     echo
   done
