@@ -70,6 +70,17 @@ public:
     return {patchVertices_.data() + patchVertexOffsets_[sphere], patchVertexOffsets_[sphere + 1] - patchVertexOffsets_[sphere]};
   }
   static constexpr std::uint32_t kMaxSpherePatchVertices = 32;
+  /// For a sphere without patch vertices (a curved patch, or a faceted one with more than
+  /// kMaxSpherePatchVertices): mesh vertices of its triangles whose max of n . v is the patch's
+  /// support in direction n to within sphereSupportSlack (all of them for small patches, the
+  /// extreme vertices of 256 directions for larger ones); empty for faceted patches. The cfm
+  /// model uses them as a curved patch's support function and as the points it rests on
+  /// (docs/narrow-phase.md, "Curved patches").
+  std::span<const std::uint32_t> sphereSupportVertices(std::uint32_t sphere) const noexcept {
+    return {supportVertices_.data() + supportVertexOffsets_[sphere],
+            supportVertexOffsets_[sphere + 1] - supportVertexOffsets_[sphere]};
+  }
+  double sphereSupportSlack(std::uint32_t sphere) const noexcept { return supportSlack_[sphere]; }
   /// For a sphere with patch vertices: the distinct directions (unit, sign arbitrary) of the body
   /// edges among its triangles' edges (sharp: the neighbour's normal differs; or a border), when
   /// there are at most kMaxSphereEdgeDirections; empty otherwise. The cfm model crosses them with
@@ -118,6 +129,9 @@ private:
   std::vector<std::uint32_t> patchVertices_;
   std::vector<std::uint32_t> edgeDirectionOffsets_;
   std::vector<Vec3f> edgeDirections_;
+  std::vector<std::uint32_t> supportVertexOffsets_;
+  std::vector<std::uint32_t> supportVertices_;
+  std::vector<double> supportSlack_;
   double diagonal_ = 0.0;
   bool convexPolyhedron_ = false;     // closed and convex (isConvexPolyhedron)
   std::size_t usedVertexCount_ = 0;   // distinct vertices referenced by triangles

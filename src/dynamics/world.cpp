@@ -28,6 +28,12 @@ constexpr double kWarmStartNormalCos = 0.95;
 // less than this fraction of the smaller body's diagonal (tangentially) and have not opened by
 // more than it (Bullet's contact breaking threshold plays the same role: 2 cm for unit bodies).
 constexpr double kAnchorDriftRel = 0.01;
+// Substeps for bodies about to touch (World::step): two bodies whose boxes, grown by their travel
+// over the step, overlap move at most this fraction of the smaller body's diagonal together per
+// substep, so a body arriving at speed is first found at most that deep inside the other (issue
+// 17 allows 1 % at any frame), in at most kMaxArrivalSubsteps substeps from this rule.
+constexpr double kArrivalTravelRel = 0.005;
+constexpr double kMaxArrivalSubsteps = 8.0;
 
 bool finite(const Vec3& v) { return v.allFinite(); }
 
@@ -837,10 +843,19 @@ const StepReport& World::step(double dt) {
     m.boxes[i] = b.worldBox(m.stepTravel[i]);
   }
   findOverlappingPairs(m.boxes, m.active.data(), m.candidates, m.bpScratch);
-  for (const BodyPair& c : m.candidates) maxTravel = std::max({maxTravel, m.stepTravel[c[0]], m.stepTravel[c[1]]});
+  // Two rules, the larger wins: no body travels more than kTravelFraction of the thinnest
+  // extent (no tunnelling), and two bodies that may touch this step travel together at most
+  // kArrivalTravelRel of the smaller diagonal (no deep first contact; capped, see above).
+  double arrivalSubsteps = 0.0;
+  for (const BodyPair& c : m.candidates) {
+    maxTravel = std::max({maxTravel, m.stepTravel[c[0]], m.stepTravel[c[1]]});
+    const double diag = std::min(m.bodies[c[0]].desc.shape->diagonal(), m.bodies[c[1]].desc.shape->diagonal());
+    arrivalSubsteps = std::max(arrivalSubsteps, (m.stepTravel[c[0]] + m.stepTravel[c[1]]) / (kArrivalTravelRel * diag));
+  }
   std::uint32_t n = m.settings.minSubsteps;
   if (std::isfinite(minExtent) && maxTravel > 0.0) {
-    const double want = std::ceil(maxTravel / (kTravelFraction * minExtent));
+    const double want =
+        std::ceil(std::max(std::min(arrivalSubsteps, kMaxArrivalSubsteps), maxTravel / (kTravelFraction * minExtent)));
     n = std::isfinite(want) ? std::uint32_t(std::clamp(want, double(n), double(m.settings.maxSubsteps))) : m.settings.maxSubsteps;
   }
   m.report.substeps = n;

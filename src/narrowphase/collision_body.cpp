@@ -6,6 +6,7 @@
 
 #include "clod/bake.h"
 #include "clod/error.h"
+#include "patch_hull.h"
 
 namespace clod {
 namespace {
@@ -57,6 +58,7 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree) : mesh_(std::mo
 
   faceNormalOffsets_.assign(1, 0);
   patchVertexOffsets_.assign(1, 0);
+  supportVertexOffsets_.assign(1, 0);
   std::vector<Vec3> distinct;
   std::vector<std::uint32_t> vertices;
   std::vector<Vec3> edgeDirections;
@@ -131,6 +133,9 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree) : mesh_(std::mo
     edgeDirectionOffsets_.push_back(static_cast<std::uint32_t>(edgeDirections_.size()));
     faceNormalOffsets_.push_back(static_cast<std::uint32_t>(faceNormals_.size()));
     patchVertexOffsets_.push_back(static_cast<std::uint32_t>(patchVertices_.size()));
+    const bool hasPatch = patchVertexOffsets_[i + 1] > patchVertexOffsets_[i];
+    supportSlack_.push_back(hasPatch ? 0.0 : detail::appendPatchSupportVertices(mesh_, tree_.triangles(i), supportVertices_));
+    supportVertexOffsets_.push_back(static_cast<std::uint32_t>(supportVertices_.size()));
   }
   classifyConvexPolyhedron(edges);
 }

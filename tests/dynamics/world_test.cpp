@@ -98,11 +98,12 @@ Collision collideCubes(double restitution, ContactModel model) {
   resting.friction = 0.0;
   resting.restitution = restitution;
   world.addBody(moving);
-  world.addBody(resting);
+  const BodyId restingId = world.addBody(resting);
   Collision c{world.kineticEnergy(), 0, world.linearMomentum(), {}, world.angularMomentum(), {}};
-  std::uint64_t contactsSeen = 0;
-  for (int i = 0; i < 60; ++i) contactsSeen += world.step(1.0 / 60.0).contacts.size();
-  EXPECT_GT(contactsSeen, 0u) << "the cubes never touched: the test would prove nothing";
+  for (int i = 0; i < 60; ++i) world.step(1.0 / 60.0);
+  // The hit may begin and end within one step's substeps, so no step need end with a contact;
+  // the resting cube moving is the proof that they touched.
+  EXPECT_GT(world.state(restingId).velocity.norm(), 0.1) << "the cubes never touched: the test would prove nothing";
   c.energyAfter = world.kineticEnergy();
   c.pAfter = world.linearMomentum();
   c.lAfter = world.angularMomentum();

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -298,4 +299,59 @@ TEST(CoarseContacts, SmallBodiesOnALargeFloorArePushedAlongTheFloorNormalAtTheRo
 }
 
 }  // namespace
+// A curved mesh (the shared bunny-1500, unit diagonal) resting on a box at 1 to 64 tests, where
+// its spheres are the root or one level below: every contact is one of its vertices that lies
+// inside the box, with the box's face normal, and its depth is that vertex's depth below the top
+// face. Oracle: the mesh's vertices, checked one by one against the box (brute force). Before,
+// the pair gave one contact at its sphere's centre with the sphere's overlap as depth, and the
+// world let the bunny sink 20 % of its diagonal within that depth's error bound.
+TEST(CoarseContacts, CurvedMeshOnABoxRestsOnItsOwnVerticesWithTheirDepths) {
+  static const CollisionBody floor = test::makeTestBody(makeBox(Vec3(2.0, 2.0, 0.25)), 2, false);
+  static const CollisionBody bunny = test::makeTestBody(test::loadUnitMesh("bunny-1500.obj"), 2, false);
+  const double floorTop = 0.25;
+  // Rounding: face planes from float face normals (~6e-8 rad over a few m) and coordinates.
+  const double rounding = 1e-6;
+  const Quat upright(Eigen::AngleAxisd(kPi / 2.0, Vec3::UnitX()));  // the bunny's base down
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const Vec3& v : bunny.mesh().vertices) lowest = std::min(lowest, (upright * v).z());
+  int cases = 0;
+  for (double penetration : {0.002, 0.01}) {
+    const Pose pose{upright, Vec3(0.1, -0.2, floorTop - lowest - penetration)};
+    // Brute force: every vertex's depth below the top face (the box is 4 x 4, wider than the bunny).
+    std::vector<double> vertexDepths;
+    for (const Vec3& v : bunny.mesh().vertices) vertexDepths.push_back(floorTop - pose.apply(v).z());
+    const double deepest = *std::max_element(vertexDepths.begin(), vertexDepths.end());
+    ASSERT_NEAR(deepest, penetration, 1e-12);
+    for (std::uint64_t budget : {std::uint64_t(1), std::uint64_t(4), std::uint64_t(16), std::uint64_t(64)}) {
+      const std::string what = "penetration " + std::to_string(penetration) + " budget " + std::to_string(budget);
+      const QueryResult r = queryContacts(bunny, pose, floor, Pose{}, settingsFor(ContactModel::kCfm, budget));
+      std::size_t exactContacts = 0;
+      double deepestExact = -std::numeric_limits<double>::infinity();
+      for (const Contact& c : r.contacts) {
+        EXPECT_LT(angleBetween(c.normal, Vec3::UnitZ()), 1e-6) << what << " normal " << c.normal.transpose();
+        if (c.errorBound > rounding) {
+          // A sphere pair whose vertices all lie outside the box (its sphere reaches in): the
+          // generic contact, whose depth only keeps its promise.
+          EXPECT_LE(std::abs(c.depth - penetration), c.errorBound) << what;
+          continue;
+        }
+        ++cases;
+        ++exactContacts;
+        // The contact lies midway between a vertex and the face: the vertex is c.point - depth/2 n_up.
+        const Vec3 vertex = c.point - 0.5 * c.depth * Vec3::UnitZ();
+        double nearest = std::numeric_limits<double>::infinity();
+        for (const Vec3& v : bunny.mesh().vertices) nearest = std::min(nearest, (pose.apply(v) - vertex).norm());
+        EXPECT_LT(nearest, rounding) << what << ": not a vertex of the mesh";
+        EXPECT_NEAR(c.depth, floorTop - vertex.z(), rounding) << what;
+        EXPECT_GT(c.depth, 0.0) << what;
+        deepestExact = std::max(deepestExact, c.depth);
+      }
+      EXPECT_GE(exactContacts, 3u) << what << ": a support area needs three points";
+      // The deepest vertex is among them.
+      EXPECT_NEAR(deepestExact, deepest, rounding) << what;
+    }
+  }
+  EXPECT_GE(cases, 24);
+}
+
 }  // namespace clod

@@ -1,0 +1,27 @@
+#pragma once
+// The support points of a sphere's patch (the triangles a sphere-tree sphere is responsible for):
+// a small set of its vertices whose maximum of n . v over them is the patch's support in any
+// direction n, to within a stated slack. CollisionBody keeps one per curved sphere; the cfm model
+// uses it as the patch's support function and as the vertices a curved patch rests on
+// (docs/narrow-phase.md, "Curved patches").
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "clod/mesh.h"
+
+namespace clod::detail {
+
+/// Patches of at most this many distinct vertices keep all of them (slack 0).
+inline constexpr std::size_t kMaxPatchSupportVertices = 64;
+
+/// Appends to `out` the support vertices (indices into mesh.vertices, ascending) of the patch made
+/// of `triangles` and returns the slack: the most by which max over them of n . v can fall short
+/// of the patch's support in any direction n. Small patches keep every vertex. Larger ones keep
+/// the extreme vertex of each of 256 spherical Fibonacci directions (an inner approximation of
+/// the convex hull); their slack is twice the largest shortfall measured over 1,024 directions.
+double appendPatchSupportVertices(const TriangleMesh& mesh, std::span<const std::uint32_t> triangles,
+                                  std::vector<std::uint32_t>& out);
+
+}  // namespace clod::detail
