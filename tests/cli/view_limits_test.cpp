@@ -20,6 +20,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cli/cli_runner.h"
 #include "cli/view_harness.h"
 
 namespace {
@@ -295,6 +296,17 @@ TEST_F(ClodViewLimits, RefusesTraversalLinksOutOfTheRootAndNonRegularFiles) {
   const auto start = Clock::now();
   EXPECT_EQ(get(server_.port, "/data/pipe").status, 404);  // a FIFO: refused, not waited on
   EXPECT_LT(secondsSince(start), 2.0);
+}
+
+TEST_F(ClodViewLimits, RefusesOutOfRangeLimitsWithExitCode2) {
+  for (const std::string& bad : std::vector<std::string>{"--max-connections 0", "--max-connections 513",
+                                                         "--header-timeout 0", "--send-timeout -1"}) {
+    const auto r = clod::test::runCli("view " + clod::test::quoted(root_ / "out") + " --viewer-dir " +
+                                      clod::test::quoted(root_ / "viewer") + " --port 0 --quit-after 5 " + bad);
+    EXPECT_EQ(r.exitCode, 2) << bad;
+    EXPECT_EQ(r.err.rfind("clod: error [", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(bad.substr(0, bad.find(' '))), std::string::npos) << r.err;
+  }
 }
 
 }  // namespace
