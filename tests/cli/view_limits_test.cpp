@@ -190,11 +190,14 @@ TEST_F(ClodViewLimits, DropsAClientThatTricklesItsHeadAfterTheHeaderTimeout) {
 TEST_F(ClodViewLimits, ChecksTheHostHeaderAgainstDnsRebinding) {
   const int port = server_.port;
   const std::string p = std::to_string(port);
-  for (const std::string& host : std::vector<std::string>{"localhost", "localhost:" + p, "LocalHost:" + p, "127.0.0.1", "127.0.0.1:" + p,
-                                 "[::1]", "[::1]:" + p})
+  const std::vector<std::string> ours{"localhost", "localhost:" + p, "LocalHost:" + p, "127.0.0.1",
+                                      "127.0.0.1:" + p, "[::1]", "[::1]:" + p};
+  for (const std::string& host : ours)
     EXPECT_EQ(request(port, requestWithHost("/", "Host: " + host + "\r\n")).status, 200) << host;
-  for (const std::string& host : std::vector<std::string>{"evil.example", "evil.example:" + p, "localhost:1", "localhost.evil.example",
-                                 "127.0.0.1.evil.example:" + p, "[::1", "10.0.0.1:" + p, "localhost:" + p + "x"})
+  const std::vector<std::string> foreign{"evil.example", "evil.example:" + p, "localhost:1", "localhost.evil.example",
+                                         "127.0.0.1.evil.example:" + p, "[::1", "10.0.0.1:" + p,
+                                         "localhost:" + p + "x"};
+  for (const std::string& host : foreign)
     EXPECT_EQ(request(port, requestWithHost("/", "Host: " + host + "\r\n")).status, 403) << host;
   EXPECT_EQ(request(port, requestWithHost("/", "")).status, 400);  // HTTP/1.1 without Host
   EXPECT_EQ(request(port, requestWithHost("/", "Host: localhost\r\nHost: evil.example\r\n")).status, 400);
