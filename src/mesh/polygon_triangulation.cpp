@@ -437,4 +437,20 @@ PolygonCut triangulatePolygon(std::span<const Vec3> corners, std::vector<Triangl
   return PolygonCut::kFanFallback;
 }
 
+PolygonCut appendFaceTriangles(const std::vector<Vec3>& vertices, std::span<const std::uint32_t> corners,
+                               std::vector<Triangle>& triangles) {
+  if (corners.size() == 3) {
+    triangles.push_back({corners[0], corners[1], corners[2]});
+    return PolygonCut::kTriangle;
+  }
+  std::vector<Vec3> positions;
+  positions.reserve(corners.size());
+  for (std::uint32_t c : corners) positions.push_back(vertices[c]);
+  const std::size_t first = triangles.size();
+  const PolygonCut cut = triangulatePolygon(positions, triangles);
+  for (std::size_t t = first; t < triangles.size(); ++t)
+    for (std::uint32_t& c : triangles[t]) c = corners[c];
+  return cut;
+}
+
 }  // namespace clod::detail

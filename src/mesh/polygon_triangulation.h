@@ -35,4 +35,9 @@ enum class PolygonCut : std::uint8_t {
 /// O(n log n) time, O(n) memory, for any input (the fallback included).
 PolygonCut triangulatePolygon(std::span<const Vec3> corners, std::vector<Triangle>& out);
 
+/// The same for a face of a mesh: corners are indices into `vertices`; appends the triangles
+/// (as indices into `vertices`) to `triangles`. A triangle goes through without allocating.
+PolygonCut appendFaceTriangles(const std::vector<Vec3>& vertices, std::span<const std::uint32_t> corners,
+                               std::vector<Triangle>& triangles);
+
 }  // namespace clod::detail
