@@ -12,6 +12,7 @@
 #include <assimp/DefaultLogger.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/LogStream.hpp>
+#include <assimp/commonMetaData.h>
 #include <assimp/config.h>
 #include <assimp/scene.h>
 
@@ -248,12 +249,18 @@ LoadedMesh finishMesh(LoadedMesh result, std::uint64_t ignoredPrimitives, const 
   return result;
 }
 
-bool isColladaName(std::string_view format) { return format == "dae" || format == "zae"; }
+// Whether Assimp's Collada reader made the scene (whatever the extension: Assimp also picks
+// readers by content). Every reader of the packaged Assimp names itself in the metadata.
+bool readByCollada(const aiScene* scene) {
+  aiString reader;
+  return scene->mMetaData && scene->mMetaData->Get(AI_METADATA_SOURCE_FORMAT, reader) &&
+         std::string_view(reader.C_Str()).starts_with("Collada");
+}
 
 // The importer's scene as one mesh: every mesh of every node, node transforms applied,
 // polygons triangulated, then finishMesh.
 LoadedMesh convertScene(const aiScene* scene, const CapturedLog& log, const std::string& source,
-                        const MeshLoadOptions& options, bool collada) {
+                        const MeshLoadOptions& options) {
   LoadedMesh result;
   applyLog(log, source, result.warnings);
   checkSceneAgainstLimits(scene, source, options);
@@ -269,7 +276,7 @@ LoadedMesh convertScene(const aiScene* scene, const CapturedLog& log, const std:
   // A Collada root node is the visual scene, which has no transform in the format: Assimp puts
   // the file's <unit> scale there (meter="0.01" would shrink the mesh 100 times), which we drop
   // to keep the coordinates as written. Its up-axis rotation is off (configureImporter).
-  if (scene->mRootNode) stack.push_back({scene->mRootNode, collada ? aiMatrix4x4() : scene->mRootNode->mTransformation});
+  if (scene->mRootNode) stack.push_back({scene->mRootNode, readByCollada(scene) ? aiMatrix4x4() : scene->mRootNode->mTransformation});
   while (!stack.empty()) {
     const Instance instance = stack.back();
     stack.pop_back();
@@ -404,16 +411,14 @@ LoadedMesh loadMesh(const std::filesystem::path& path, const MeshLoadOptions& op
   // The bytes of OBJ, OFF, PLY, glTF and GLB files are needed (text_index_check.h, off_reader.h).
   // Assimp sniffs content whatever the extension, so every file's first bytes are looked at.
   std::string text;
-  bool collada = isColladaName(format);
   if (format == "obj" || format == "off" || format == "ply" || format == "glb" || format == "gltf") {
     text = readWholeFile(path);
   } else {
-    char head[256] = {};
+    char head[64] = {};
     if (std::FILE* file = std::fopen(path.c_str(), "rb")) {
       const std::size_t n = std::fread(head, 1, sizeof head, file);
       std::fclose(file);
       const std::string_view headText(head, n);
-      collada = collada || detail::looksLikeCollada(headText);
       // All whitespace: it may still be JSON further on (glTF is recognised by content too).
       const bool blank = headText.find_first_not_of(" \t\r\n") == std::string_view::npos;
       if (detail::looksLikePly(headText) || detail::looksLikeGlb(headText) || detail::looksLikeJson(headText) ||
@@ -432,7 +437,7 @@ LoadedMesh loadMesh(const std::filesystem::path& path, const MeshLoadOptions& op
     return importChecked(imp.ReadFile(path.string(), kImportFlags), source);
   });
   if (!scene) throwImportError(source, importer.GetErrorString(), format, text);
-  return convertScene(scene, log, source, options, collada);
+  return convertScene(scene, log, source, options);
 }
 
 LoadedMesh loadMeshFromMemory(std::span<const std::byte> bytes, std::string_view formatHint,
@@ -457,7 +462,7 @@ LoadedMesh loadMeshFromMemory(std::span<const std::byte> bytes, std::string_view
     return importChecked(imp.ReadFileFromMemory(bytes.data(), bytes.size(), kImportFlags, format.c_str()), source);
   });
   if (!scene) throwImportError(source, importer.GetErrorString(), format, text);
-  return convertScene(scene, log, source, options, isColladaName(format) || detail::looksLikeCollada(text));
+  return convertScene(scene, log, source, options);
 }
 
 }  // namespace clod

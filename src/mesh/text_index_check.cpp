@@ -1,6 +1,5 @@
 #include "text_index_check.h"
 
-#include <cctype>
 #include <charconv>
 #include <cstring>
 #include <vector>
@@ -125,17 +124,6 @@ bool looksLikeJson(std::string_view text) {
   if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
   const std::size_t first = text.find_first_not_of(" \t\r\n");
   return first != std::string_view::npos && text[first] == '{';
-}
-
-bool looksLikeCollada(std::string_view head) {
-  constexpr std::string_view kTag = "<collada";
-  head = head.substr(0, 256);
-  for (std::size_t i = 0; i + kTag.size() <= head.size(); ++i) {
-    std::size_t k = 0;
-    while (k < kTag.size() && std::tolower(static_cast<unsigned char>(head[i + k])) == kTag[k]) ++k;
-    if (k == kTag.size()) return true;
-  }
-  return false;
 }
 
 std::optional<std::string_view> glbJsonChunk(std::string_view bytes) {

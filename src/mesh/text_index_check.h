@@ -40,10 +40,6 @@ std::optional<std::string> findGlbHeaderProblem(std::string_view bytes);
 /// start of a .gltf document, which Assimp recognises by content whatever the extension.
 bool looksLikeJson(std::string_view text);
 
-/// True when "<collada" (any case) occurs in the first 256 bytes: what Assimp looks for to
-/// hand content to its Collada reader whatever the extension.
-bool looksLikeCollada(std::string_view head);
-
 /// The JSON chunk of GLB content whose header findGlbHeaderProblem accepted (the first chunk,
 /// type "JSON"); nullopt when there is none. O(1).
 std::optional<std::string_view> glbJsonChunk(std::string_view bytes);

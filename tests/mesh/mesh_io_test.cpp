@@ -174,6 +174,13 @@ TEST(LoadMesh, ColladaKeepsTheFilesOwnCoordinates) {
     // Recognised by content too, as Assimp does.
     expectTheBox(loadMeshFromMemory(asBytes(text), "xml"), to + " (as .xml)");
   }
+  // A glTF file is not Collada because "<collada" appears in its first bytes: its root node's
+  // transform (the +5 in x of box.gltf) stays.
+  nlohmann::json gltf = nlohmann::json::parse(readBytes(goodFile("box.gltf")));
+  gltf["asset"]["generator"] = "<COLLADA";
+  const std::string mentioning = gltf.dump();
+  ASSERT_LT(mentioning.find("<COLLADA"), 200u);
+  expectTheBox(loadMeshFromMemory(asBytes(mentioning), "gltf"), "glTF mentioning <COLLADA");
 }
 
 TEST(LoadMesh, PointsAndLinesAreIgnoredWithAWarning) {
