@@ -12,28 +12,31 @@
 #include <assimp/DefaultLogger.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/LogStream.hpp>
-#include <assimp/postprocess.h>
+#include <assimp/commonMetaData.h>
+#include <assimp/config.h>
 #include <assimp/scene.h>
 
 #include "clod/error.h"
 #include "clod/atomic_file.h"
 #include "clod/mesh_weld.h"
+#include "load_limits.h"
 #include "off_reader.h"
+#include "polygon_triangulation.h"
 #include "text_index_check.h"
 
 namespace clod {
 
 namespace {
 
-// Post-processing: only triangulation, applied after checkRawScene (below) has looked at the
-// importer's output, because the packaged Assimp is built with its internal asserts enabled and
-// aborts the process when triangulating a face without indices (fuzz_mesh_load found an OFF
-// file that produces one). Deliberately absent: JoinIdenticalVertices (we weld with a tolerance),
-// FindDegenerates / FindInvalidData (they drop or alter triangles, hiding the counts we report),
-// FixInfacingNormals (it guesses; we orient by signed volume), ValidateDataStructure (its
-// findings arrive as log lines; we check ourselves), PreTransformVertices (we apply node
-// transforms ourselves, instancing meshes referenced by several nodes).
-constexpr unsigned kPostProcessFlags = aiProcess_Triangulate;
+// No Assimp post-processing at all. Triangulate: its ear clipping takes ~n^2.3 for a face of
+// n corners (> 400 s for one 100,000-corner OBJ face), and the packaged Assimp, built with its
+// asserts on, aborts on a face without indices; polygons are triangulated in convertScene
+// instead (polygon_triangulation.h). JoinIdenticalVertices: we weld with a tolerance.
+// FindDegenerates / FindInvalidData: they drop or alter triangles, hiding the counts we report.
+// FixInfacingNormals: it guesses; we orient by signed volume. ValidateDataStructure: we check
+// ourselves (checkRawScene). PreTransformVertices: we apply node transforms ourselves,
+// instancing meshes referenced by several nodes.
+constexpr unsigned kImportFlags = 0;
 
 // Some Assimp importers repair bad data and only log it (the OFF reader clamps an out-of-range
 // index to the last vertex; the glTF reader drops faces with out-of-range indices). So every
@@ -108,11 +111,16 @@ void checkRawScene(const aiScene* scene, const std::string& source) {
   }
 }
 
-// Import without post-processing, check, then triangulate (see kPostProcessFlags).
-const aiScene* importChecked(Assimp::Importer& importer, const aiScene* raw, const std::string& source) {
-  if (!raw) return nullptr;
-  checkRawScene(raw, source);
-  return importer.ApplyPostProcessing(kPostProcessFlags);
+// The importer's scene, checked (see kImportFlags).
+const aiScene* importChecked(const aiScene* raw, const std::string& source) {
+  if (raw) checkRawScene(raw, source);
+  return raw;
+}
+
+// Coordinates as written in the file (docs/conventions.md). Assimp's Collada reader rotates
+// Z-up and X-up files to Y-up unless told not to; its <unit> scaling is undone in convertScene.
+void configureImporter(Assimp::Importer& importer) {
+  importer.SetPropertyInteger(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, 1);
 }
 
 bool mentionsIndexOutOfRange(const std::string& message) {
@@ -152,6 +160,45 @@ struct Instance {
   const aiNode* node;
   aiMatrix4x4 transform;
 };
+
+// Vertex and triangle totals of the mesh convertScene would build (each mesh once per node that
+// refers to it) and the largest polygon, held against the limits before anything is copied.
+void checkSceneAgainstLimits(const aiScene* scene, const std::string& source, const MeshLoadOptions& options) {
+  std::vector<std::uint64_t> trianglesOfMesh(scene->mNumMeshes, 0);
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* mesh = scene->mMeshes[m];
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const unsigned corners = mesh->mFaces[f].mNumIndices;
+      if (corners > options.maxPolygonVertices)
+        detail::enforceLimit(corners, options.maxPolygonVertices, "maxPolygonVertices", "corners in one face",
+                             source + ": mesh " + std::to_string(m) + ", face " + std::to_string(f));
+      if (corners >= 3) trianglesOfMesh[m] += corners - 2;
+    }
+  }
+  std::uint64_t vertices = 0, triangles = 0;
+  std::vector<const aiNode*> stack;
+  if (scene->mRootNode) stack.push_back(scene->mRootNode);
+  while (!stack.empty()) {
+    const aiNode* node = stack.back();
+    stack.pop_back();
+    for (unsigned c = 0; c < node->mNumChildren; ++c)
+      if (node->mChildren[c]) stack.push_back(node->mChildren[c]);
+    for (unsigned k = 0; k < node->mNumMeshes; ++k) {
+      const unsigned m = node->mMeshes[k];
+      if (m >= scene->mNumMeshes) continue;  // convertScene names it
+      vertices += scene->mMeshes[m]->mNumVertices;
+      triangles += trianglesOfMesh[m];
+    }
+    detail::enforceLimit(vertices, options.maxVertices, "maxVertices", "vertices or more in the imported scene", source);
+    detail::enforceLimit(triangles, options.maxTriangles, "maxTriangles", "triangles or more in the imported scene", source);
+  }
+}
+
+void noteFannedPolygons(std::uint64_t count, std::vector<std::string>& warnings) {
+  if (count > 0)
+    warnings.push_back(std::to_string(count) + " polygon(s) not simple in their best-fit plane (self-intersecting, "
+                       "zero area or strongly warped) were fan-triangulated from their first corner");
+}
 
 // Everything after reading, shared by all formats: fatal checks, weld, validate, orient.
 LoadedMesh finishMesh(LoadedMesh result, std::uint64_t ignoredPrimitives, const std::string& source,
@@ -202,20 +249,34 @@ LoadedMesh finishMesh(LoadedMesh result, std::uint64_t ignoredPrimitives, const 
   return result;
 }
 
-// The checks Assimp needs before it sees the bytes (see text_index_check.h).
+// Whether Assimp's Collada reader made the scene (whatever the extension: Assimp also picks
+// readers by content). Every reader of the packaged Assimp names itself in the metadata.
+bool readByCollada(const aiScene* scene) {
+  aiString reader;
+  return scene->mMetaData && scene->mMetaData->Get(AI_METADATA_SOURCE_FORMAT, reader) &&
+         std::string_view(reader.C_Str()).starts_with("Collada");
+}
+
+// The importer's scene as one mesh: every mesh of every node, node transforms applied,
+// polygons triangulated, then finishMesh.
 LoadedMesh convertScene(const aiScene* scene, const CapturedLog& log, const std::string& source,
                         const MeshLoadOptions& options) {
   LoadedMesh result;
   applyLog(log, source, result.warnings);
+  checkSceneAgainstLimits(scene, source, options);
   TriangleMesh& mesh = result.mesh;
-  std::uint64_t ignoredPrimitives = 0;
-  std::uint64_t totalVertices = 0, totalTriangles = 0;
+  std::uint64_t ignoredPrimitives = 0, fannedPolygons = 0;
+  std::uint64_t totalVertices = 0;
+  std::vector<std::uint32_t> corners;
   constexpr std::uint64_t kMaxElements = std::numeric_limits<std::uint32_t>::max() - 1;
 
   // Depth-first over the node graph with accumulated transforms; explicit stack, since a
   // hostile file can nest nodes deeply.
   std::vector<Instance> stack;
-  if (scene->mRootNode) stack.push_back({scene->mRootNode, scene->mRootNode->mTransformation});
+  // A Collada root node is the visual scene, which has no transform in the format: Assimp puts
+  // the file's <unit> scale there (meter="0.01" would shrink the mesh 100 times), which we drop
+  // to keep the coordinates as written. Its up-axis rotation is off (configureImporter).
+  if (scene->mRootNode) stack.push_back({scene->mRootNode, readByCollada(scene) ? aiMatrix4x4() : scene->mRootNode->mTransformation});
   while (!stack.empty()) {
     const Instance instance = stack.back();
     stack.pop_back();
@@ -261,31 +322,38 @@ LoadedMesh convertScene(const aiScene* scene, const CapturedLog& log, const std:
       if (in->mNumFaces > 0 && !in->mFaces) throw Error(ErrorCode::kParseError, where + ": no faces");
       for (unsigned f = 0; f < in->mNumFaces; ++f) {
         const aiFace& face = in->mFaces[f];
-        if (face.mNumIndices != 3) {
-          // Points and lines; polygons cannot remain after aiProcess_Triangulate.
-          ++ignoredPrimitives;
+        if (face.mNumIndices < 3) {
+          ++ignoredPrimitives;  // points and lines
           continue;
         }
-        Triangle t;
-        for (unsigned c = 0; c < 3; ++c) {
+        corners.clear();
+        for (unsigned c = 0; c < face.mNumIndices; ++c) {
           const unsigned index = face.mIndices[c];
           if (index >= in->mNumVertices)
             throw Error(ErrorCode::kIndexOutOfRange, where + ", face " + std::to_string(f) + ": vertex index " +
                                                          std::to_string(index) + " >= vertex count " +
                                                          std::to_string(in->mNumVertices));
-          t[c] = base + index;
+          corners.push_back(base + index);
         }
-        if (mirrored) std::swap(t[1], t[2]);
-        if (++totalTriangles > kMaxElements) throw Error(ErrorCode::kUnsupportedMesh, source + ": more than 2^32 - 2 triangles");
-        mesh.triangles.push_back(t);
+        const std::size_t first = mesh.triangles.size();
+        // Triangulated in world coordinates: wound like the face there, then unmirrored below.
+        if (detail::appendFaceTriangles(mesh.vertices, corners, mesh.triangles) == detail::PolygonCut::kFanFallback)
+          ++fannedPolygons;
+        if (mirrored)
+          for (std::size_t t = first; t < mesh.triangles.size(); ++t) std::swap(mesh.triangles[t][1], mesh.triangles[t][2]);
+        if (mesh.triangles.size() > kMaxElements) throw Error(ErrorCode::kUnsupportedMesh, source + ": more than 2^32 - 2 triangles");
       }
     }
   }
 
+  noteFannedPolygons(fannedPolygons, result.warnings);
   return finishMesh(std::move(result), ignoredPrimitives, source, options);
 }
 
-void checkText(std::string_view text, const std::string& source, const MeshLoadOptions& options) {
+// The checks Assimp needs before it sees the bytes (see text_index_check.h), and the declared
+// counts against the limits (load_limits.h).
+void checkText(std::string_view text, std::string_view format, const std::string& source,
+               const MeshLoadOptions& options) {
   if (auto problem = detail::findPlyHeaderProblem(text)) throw Error(ErrorCode::kParseError, source + ": " + *problem);
   if (auto problem = detail::findGlbHeaderProblem(text)) throw Error(ErrorCode::kParseError, source + ": " + *problem);
   // glTF JSON, plain or in a GLB, is parsed by a recursive parser (MeshLoadOptions::maxJsonDepth).
@@ -296,6 +364,7 @@ void checkText(std::string_view text, const std::string& source, const MeshLoadO
     if (auto problem = detail::findJsonDepthProblem(*json, options.maxJsonDepth))
       throw Error(ErrorCode::kParseError, source + ": " + *problem);
   }
+  detail::checkDeclaredCounts(text, format, source, options);
 }
 
 // OFF goes to our own reader (off_reader.h): by name, or by content whatever the name, because
@@ -307,9 +376,10 @@ bool useOffReader(std::string_view format, std::string_view head) {
 }
 
 LoadedMesh loadOff(std::string_view text, const std::string& source, const MeshLoadOptions& options) {
-  detail::OffContent content = detail::readOff(text, source);
+  detail::OffContent content = detail::readOff(text, source, options);
   LoadedMesh result;
   result.mesh = std::move(content.mesh);
+  noteFannedPolygons(content.fannedPolygons, result.warnings);
   return finishMesh(std::move(result), content.ignoredPrimitives, source, options);
 }
 
@@ -357,13 +427,14 @@ LoadedMesh loadMesh(const std::filesystem::path& path, const MeshLoadOptions& op
     }
   }
   if (useOffReader(format, text)) return loadOff(text, source, options);
-  checkText(text, source, options);
+  checkText(text, format, source, options);
 
   Assimp::Importer importer;
+  configureImporter(importer);
   CapturedLog log;
   // Through ReadFile, not from memory, so that a .gltf finds its external .bin next to it.
   const aiScene* scene = importCapturingLog(importer, log, [&](Assimp::Importer& imp) {
-    return importChecked(imp, imp.ReadFile(path.string(), 0), source);
+    return importChecked(imp.ReadFile(path.string(), kImportFlags), source);
   });
   if (!scene) throwImportError(source, importer.GetErrorString(), format, text);
   return convertScene(scene, log, source, options);
@@ -382,12 +453,13 @@ LoadedMesh loadMeshFromMemory(std::span<const std::byte> bytes, std::string_view
   if (bytes.empty()) throw Error(ErrorCode::kEmptyFile, source + " is empty (0 bytes)");
   const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
   if (useOffReader(format, text)) return loadOff(text, source, options);
-  checkText(text, source, options);
+  checkText(text, format, source, options);
 
   Assimp::Importer importer;
+  configureImporter(importer);
   CapturedLog log;
   const aiScene* scene = importCapturingLog(importer, log, [&](Assimp::Importer& imp) {
-    return importChecked(imp, imp.ReadFileFromMemory(bytes.data(), bytes.size(), 0, format.c_str()), source);
+    return importChecked(imp.ReadFileFromMemory(bytes.data(), bytes.size(), kImportFlags, format.c_str()), source);
   });
   if (!scene) throwImportError(source, importer.GetErrorString(), format, text);
   return convertScene(scene, log, source, options);

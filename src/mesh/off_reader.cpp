@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "clod/error.h"
+#include "load_limits.h"
+#include "polygon_triangulation.h"
 
 namespace clod::detail {
 
@@ -80,7 +82,7 @@ bool looksLikeOff(std::string_view text) {
   return lower(text[0]) == 'o' && lower(text[1]) == 'f' && lower(text[2]) == 'f';
 }
 
-OffContent readOff(std::string_view text, const std::string& source) {
+OffContent readOff(std::string_view text, const std::string& source, const MeshLoadOptions& limits) {
   LineReader reader(text);
   std::vector<std::string_view> tokens;
   auto fail = [&](ErrorCode code, const std::string& what) -> Error {
@@ -104,6 +106,8 @@ OffContent readOff(std::string_view text, const std::string& source) {
   if (tokens.size() < first + 2 || !parseInteger(tokens[first], vertexCount) || !parseInteger(tokens[first + 1], faceCount) ||
       vertexCount < 0 || faceCount < 0)
     throw fail(ErrorCode::kParseError, "expected 'vertexCount faceCount [edgeCount]'");
+  const std::string countsLine = source + ": line " + std::to_string(reader.lineNumber());
+  enforceLimit(std::uint64_t(vertexCount), limits.maxVertices, "maxVertices", "vertices declared", countsLine);
   // Every vertex and face needs at least a few bytes, so larger counts cannot be honest and
   // would only make us allocate for nothing.
   if (vertexCount > static_cast<long long>(text.size()) || faceCount > static_cast<long long>(text.size()))
@@ -127,6 +131,9 @@ OffContent readOff(std::string_view text, const std::string& source) {
     if (!parseInteger(tokens[0], n) || n < 1)
       throw fail(ErrorCode::kParseError, "face " + std::to_string(f) + ": '" + std::string(tokens[0]) +
                                              "' is not a vertex count >= 1");
+    if (static_cast<unsigned long long>(n) > limits.maxPolygonVertices)
+      enforceLimit(std::uint64_t(n), limits.maxPolygonVertices, "maxPolygonVertices", "corners in one face",
+                   source + ": line " + std::to_string(reader.lineNumber()) + ": face " + std::to_string(f));
     if (static_cast<long long>(tokens.size()) - 1 < n)
       throw fail(ErrorCode::kParseError, "face " + std::to_string(f) + ": " + std::to_string(n) + " vertices announced, " +
                                              std::to_string(tokens.size() - 1) + " values given");
@@ -145,7 +152,10 @@ OffContent readOff(std::string_view text, const std::string& source) {
       ++content.ignoredPrimitives;
       continue;
     }
-    for (std::size_t k = 1; k + 1 < polygon.size(); ++k) mesh.triangles.push_back({polygon[0], polygon[k], polygon[k + 1]});
+    if (mesh.triangles.size() + (polygon.size() - 2) > limits.maxTriangles)
+      enforceLimit(mesh.triangles.size() + (polygon.size() - 2), limits.maxTriangles, "maxTriangles", "triangles so far",
+                   source + ": line " + std::to_string(reader.lineNumber()) + ": face " + std::to_string(f));
+    if (appendFaceTriangles(mesh.vertices, polygon, mesh.triangles) == PolygonCut::kFanFallback) ++content.fannedPolygons;
   }
   return content;
 }

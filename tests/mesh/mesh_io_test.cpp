@@ -71,12 +71,14 @@ void expectTheBox(const LoadedMesh& loaded, const std::string& name) {
 }
 
 TEST(LoadMesh, EveryFormatLoadsTheSameBox) {
-  for (const char* name : {"box.obj", "box_ascii.stl", "box_binary.stl", "box.ply", "box.off", "box.gltf", "box.glb"})
+  for (const char* name : {"box.obj", "box_ascii.stl", "box_binary.stl", "box.ply", "box.off", "box.gltf", "box.glb",
+                           "box_z_up.dae"})
     expectTheBox(loadMesh(goodFile(name)), name);
 }
 
 TEST(LoadMesh, EveryFormatLoadsTheSameBoxFromMemory) {
-  for (const char* name : {"box.obj", "box_ascii.stl", "box_binary.stl", "box.ply", "box.off", "box.gltf", "box.glb"}) {
+  for (const char* name : {"box.obj", "box_ascii.stl", "box_binary.stl", "box.ply", "box.off", "box.gltf", "box.glb",
+                           "box_z_up.dae"}) {
     const std::string bytes = readBytes(goodFile(name));
     std::string hint = name;
     hint = hint.substr(hint.rfind('.') + 1);
@@ -153,6 +155,32 @@ TEST(LoadMesh, GltfNodeTransformsAreAppliedAndMirroringKeepsOutward) {
   EXPECT_EQ(two.report.components, 2u);
   EXPECT_EQ(two.report.bounds.max, Vec3(16, 2, 3));  // [-5,-4] + 20
   EXPECT_EQ(*two.report.signedVolume, 12.0);
+}
+
+// Collada: vertices as written in the file whatever its <up_axis> and <unit> (Assimp would
+// rotate Z-up and X-up files to Y-up and scale by the unit); node transforms still apply.
+TEST(LoadMesh, ColladaKeepsTheFilesOwnCoordinates) {
+  const std::string zUp = readBytes(goodFile("box_z_up.dae"));
+  auto variant = [&](const std::string& from, const std::string& to) {
+    std::string text = zUp;
+    text.replace(text.find(from), from.size(), to);
+    return text;
+  };
+  const std::pair<std::string, std::string> variants[] = {
+      {"Z_UP", "Z_UP"}, {"Z_UP", "Y_UP"}, {"Z_UP", "X_UP"}, {"meter=\"1\"", "meter=\"0.01\""}};
+  for (const auto& [from, to] : variants) {
+    const std::string text = variant(from, to);
+    expectTheBox(loadMeshFromMemory(asBytes(text), "dae"), to);
+    // Recognised by content too, as Assimp does.
+    expectTheBox(loadMeshFromMemory(asBytes(text), "xml"), to + " (as .xml)");
+  }
+  // A glTF file is not Collada because "<collada" appears in its first bytes: its root node's
+  // transform (the +5 in x of box.gltf) stays.
+  nlohmann::json gltf = nlohmann::json::parse(readBytes(goodFile("box.gltf")));
+  gltf["asset"]["generator"] = "<COLLADA";
+  const std::string mentioning = gltf.dump();
+  ASSERT_LT(mentioning.find("<COLLADA"), 200u);
+  expectTheBox(loadMeshFromMemory(asBytes(mentioning), "gltf"), "glTF mentioning <COLLADA");
 }
 
 TEST(LoadMesh, PointsAndLinesAreIgnoredWithAWarning) {

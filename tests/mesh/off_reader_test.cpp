@@ -22,7 +22,7 @@ Thrown thrownBy(std::string_view text) {
   return {ErrorCode::kInvalidArgument, ""};
 }
 
-TEST(ReadOff, ReadsTheVariantsAndFanTriangulatesPolygons) {
+TEST(ReadOff, ReadsTheVariantsAndTriangulatesConvexPolygonsAsFans) {
   const OffContent plain = readOff("OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n", "f.off");
   ASSERT_EQ(plain.mesh.vertexCount(), 4u);
   ASSERT_EQ(plain.mesh.triangles.size(), 2u);
@@ -55,8 +55,10 @@ TEST(ReadOff, NamesTheLineOfEveryKindOfProblem) {
   EXPECT_EQ(t.message, "f.off: the file ends before face 1 of 2");
   t = thrownBy("NOPE\n3 1 0\n");
   EXPECT_EQ(t.code, ErrorCode::kParseError);
+  t = thrownBy("OFF\n99999999 1 0\n0 0 0\n");
+  EXPECT_EQ(t.code, ErrorCode::kParseError);  // counts under the limits but larger than the file can hold
   t = thrownBy("OFF\n999999999 1 0\n0 0 0\n");
-  EXPECT_EQ(t.code, ErrorCode::kParseError);  // counts larger than the file can hold
+  EXPECT_EQ(t.code, ErrorCode::kUnsupportedMesh);  // past MeshLoadOptions::maxVertices
   t = thrownBy("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 x\n");
   EXPECT_EQ(t.message, "f.off: line 6: face 0: 'x' is not a vertex index");
 }
