@@ -118,6 +118,47 @@ bool projectOntoSurface(const ContactTree& tree, std::uint32_t maxDepth, Vec3& p
   return false;
 }
 
+// An interrupted query's coarse pair spreads its samples evenly over the two cells' overlap,
+// which misses a contact region smaller than the spacing: a bunny's base on a box met no sample
+// at 16-64 tests per frame until it had sunk 30 % of its diagonal. So a sample of S that lies
+// outside O there slides along S's surface down O's field -- the tangential part of O's gradient,
+// a Newton step toward O's zero level, at most one spacing per step, kSlideSteps steps -- to
+// where S enters O: the local search for the deepest points of Macklin et al. 2020 ("Local
+// optimization for robust signed distance field collision"), started from the lattice. On an
+// inner non-flat cell each step lands back on S's surface (projectOntoSurface); on a flat one the
+// step is in its plane. False when the sample leaves either cell or does not get inside O.
+constexpr int kSlideSteps = 4;
+
+struct SlideFrame {
+  const ContactTree& treeS;
+  const ContactCell& cellS;
+  const ContactTree& treeO;
+  const ContactCell& cellO;
+  const Pose& xfOFromS;
+  std::uint32_t maxDepth;
+  double marginAbs;
+  bool project;     // land each step on S's surface (inner non-flat cell)
+  double maxStep;   // one sample spacing
+};
+
+bool slideIntoOther(const SlideFrame& fr, Vec3& pS, SurfacePoint& surface, Vec3& pO, ContactFieldSample& f) {
+  const Eigen::Matrix3d sFromO = fr.xfOFromS.rotation.conjugate().toRotationMatrix();
+  for (int step = 0; step < kSlideSteps; ++step) {
+    const Vec3 g = sFromO * f.gradient;
+    const Vec3 tangent = g - g.dot(surface.normal) * surface.normal;
+    const double slope = tangent.norm();
+    if (!(slope > 1e-6)) return false;  // O's field does not fall along S's surface here
+    pS -= std::min(f.distance / slope, fr.maxStep) * (tangent / slope);
+    if (fr.project && !projectOntoSurface(fr.treeS, fr.maxDepth, pS, surface)) return false;
+    if (!insideCell(fr.treeS, fr.cellS, pS)) return false;
+    pO = fr.xfOFromS.apply(pS);
+    if (!insideCell(fr.treeO, fr.cellO, pO)) return false;
+    f = fr.treeO.sample(pO, fr.maxDepth);
+    if (f.distance <= fr.marginAbs) return true;
+  }
+  return false;
+}
+
 void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const Pose& xfWorldFromS,
                      const ContactTree& treeO, const ContactCell& cellO, const Pose& xfWorldFromO,
                      const ContactSamplingSettings& settings, std::vector<ContactPoint>& out,
@@ -208,21 +249,33 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
   const bool project = !flatS && !treeS.isLeaf(cellS.node);
   const int layers = settings.offSurfaceDepthRel > 0.0 ? 2 : 1;
   const int iFirst = spread ? 0 : i0 - reach, jFirst = spread ? 0 : j0 - reach;
+  const Pose xfOFromS = xfWorldFromO.inverse() * xfWorldFromS;
+  const SlideFrame slide{treeS, cellS, treeO, cellO, xfOFromS, settings.maxDepth, settings.marginAbs, project,
+                         spread ? std::max(spreadStepU, spreadStepV) : spacing};
   for (int i = iFirst; i <= i0 + reach; ++i) {
     for (int j = jFirst; j <= j0 + reach; ++j) {
       Vec3 onSurface = spread ? Vec3(spreadOrigin + (i * spreadStepU) * u + (j * spreadStepV) * v)
                               : Vec3(onPlane + (i * spacing) * u + (j * spacing) * v);
       SurfacePoint surface{n, flatS, h, 0.0};
       if (project && !projectOntoSurface(treeS, settings.maxDepth, onSurface, surface)) continue;
-      const Vec3 normalWorldS = xfWorldFromS.rotation * surface.normal;
+      Vec3 normalWorldS = xfWorldFromS.rotation * surface.normal;
       for (int layer = 0; layer < layers; ++layer) {
-        const Vec3 pS = onSurface - (layer * settings.offSurfaceDepthRel * hMin) * surface.normal;
+        Vec3 pS = onSurface - (layer * settings.offSurfaceDepthRel * hMin) * surface.normal;
         if (!insideCell(treeS, cellS, pS)) continue;
-        const Vec3 pWorld = xfWorldFromS.apply(pS);
-        const Vec3 pO = xfWorldFromO.applyInverse(pWorld);
+        Vec3 pWorld = xfWorldFromS.apply(pS);
+        Vec3 pO = xfWorldFromO.applyInverse(pWorld);
         if (!insideCell(treeO, cellO, pO)) continue;
-        const ContactFieldSample f = treeO.sample(pO, settings.maxDepth);
-        if (f.distance > settings.marginAbs) continue;
+        ContactFieldSample f = treeO.sample(pO, settings.maxDepth);
+        if (f.distance > settings.marginAbs) {
+          Vec3 slidS = pS, slidO = pO;
+          SurfacePoint slidSurface = surface;
+          if (!spread || layer > 0 || !slideIntoOther(slide, slidS, slidSurface, slidO, f)) continue;
+          pS = slidS;
+          pO = slidO;
+          surface = slidSurface;
+          pWorld = xfWorldFromS.apply(pS);
+          normalWorldS = xfWorldFromS.rotation * surface.normal;
+        }
         const double gradientLength = f.gradient.norm();
         if (!(gradientLength > 1e-12)) continue;  // flat interpolant: no direction to push
         Vec3 normal = xfWorldFromO.rotation * (f.gradient / gradientLength);
