@@ -12,6 +12,7 @@
 
 #include "clod/contact_normal.h"
 #include "clod/error.h"
+#include "containment.h"
 #include "face_overlap.h"
 #include "triangle_intersection.h"
 
@@ -62,6 +63,9 @@ public:
     ++used_;
     return true;
   }
+  // Counts `n` tests of work that is done whatever the budget (the containment answer), as far
+  // as the limit allows: `used` never exceeds maxTests, and nothing stops.
+  void count(std::uint64_t n) { used_ += std::min(n, limit_ > used_ ? limit_ - used_ : 0); }
   bool stopped() const { return stopped_; }
   QueryStop stop() const { return stop_; }
   std::uint64_t used() const { return used_; }
@@ -284,6 +288,7 @@ struct QueryScratch::Impl {
   std::vector<Contact> raw;
   std::vector<ContactPoint> sampled;
   std::vector<double> manifold;
+  detail::ContainmentScratch containment;
   // Seconds per frontier pair of turning a frontier into contacts, per model (index =
   // ContactModel), learned from this scratch's deadline queries (QueryBudget::answerWithinDeadline).
   // Starting values: medians measured on the deep benchmark poses (bench_narrowphase
@@ -1528,6 +1533,25 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
       c->valid = !s.cellFront.empty();
       c->cellOverlapping.assign(s.cellFront.begin(), s.cellFront.end());
       c->cellSeparated.assign(s.cellSeparated.begin(), s.cellSeparated.end());
+    }
+  }
+
+  {
+    // Containment (docs/narrow-phase.md): one closed body wholly inside the other. Its surfaces
+    // meet nothing: the query found no contact, or only loose sphere pairs' ones. A few exact field
+    // queries, only when the root spheres overlap (and, with contacts, only when one root sphere
+    // lies inside the other); counted as tests as far as the budget allows (the answer is given
+    // whatever the budget).
+    const bool haveContacts = !s.raw.empty();
+    const std::size_t first = s.raw.size();
+    bool found = false;
+    const std::uint32_t queries = detail::containmentContacts(a, b, xfAFromB, settings.maxContacts, haveContacts,
+                                                              s.containment, s.raw, found);
+    meter.count(queries);
+    if (found) {
+      s.raw.erase(s.raw.begin(), s.raw.begin() + static_cast<std::ptrdiff_t>(first));
+      result.colliding = true;
+      for (Contact& ct : s.raw) ct = toWorld(ct, xfWorldFromA);
     }
   }
 

@@ -1,0 +1,69 @@
+#pragma once
+// Containment: one closed body wholly inside another. Their surfaces do not meet, so the
+// sphere-tree and contact-tree descents find no overlapping surface pair and every model would
+// answer "apart" -- for the deepest penetration there is. queryContacts calls this when a query
+// ends without a contact although the two root spheres overlap (docs/narrow-phase.md,
+// "Containment"). Internal to the narrow phase.
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "clod/collision_body.h"
+#include "clod/contact.h"
+#include "clod/math.h"
+
+namespace clod::detail {
+
+/// Working memory of containmentContacts (reused: no allocation once grown, except the
+/// closedness check of a mesh the scratch has not seen yet).
+struct ContainmentScratch {
+  std::vector<std::pair<double, std::uint32_t>> heap;  // best-first sphere-tree search
+  std::vector<std::uint32_t> triangles;                // triangles around a closest vertex/edge
+  struct ClosedEntry {
+    std::uint64_t hash;  // of the triangle index array (closedness depends on nothing else)
+    std::uint64_t count;
+    bool closed;
+  };
+  std::vector<ClosedEntry> closedCache;  // at most kClosedCacheSize entries, oldest replaced
+  std::uint32_t closedCacheNext = 0;
+  static constexpr std::uint32_t kClosedCacheSize = 64;
+};
+
+/// Signed distance of a body's surface at p (body frame), negative inside, with the field's
+/// gradient direction (unit; points toward increasing distance, i.e. out of the body at its
+/// nearest surface) and an error bound on the distance (0: exact). A best-first search of the
+/// sphere-tree's leaves with closestPointOnTriangle (proximity.h), signed by the angle-weighted
+/// pseudonormal of the closest feature (Baerentzen & Aanaes 2005; exact for closed, consistently
+/// oriented meshes). O(log T) typical, no allocation once the scratch has grown. The contact tree
+/// is not used: deep inside a body its coarse cells' gradient is far off (a sphere 0.7 inside a
+/// box's +x face: 33 deg).
+struct FieldValue {
+  double distance = 0.0;
+  Vec3 gradient = Vec3::UnitX();
+  double errorBound = 0.0;
+};
+FieldValue exactBodyField(const CollisionBody& body, const Vec3& pLocal, ContainmentScratch& scratch);
+
+/// True when the body's mesh is closed (every edge shared by exactly two triangles,
+/// MeshTopology::closed). Cached in the scratch by a hash of the triangle indices.
+bool bodyIsClosed(const CollisionBody& body, ContainmentScratch& scratch);
+
+/// Containment contacts (A's frame, normal from B toward A) when A lies wholly inside B or B
+/// inside A. Two triggers:
+///  * haveContacts false (the query found none) and the root spheres overlap: a seed vertex of
+///    each body is tested against the other body's field; inside a closed body means wholly
+///    inside (the surfaces do not meet, or the query would have found a contact);
+///  * haveContacts true: the model's contacts stand unless a body's root sphere lies wholly
+///    inside the other closed body (the field at its centre < -its radius): then the surfaces
+///    cannot meet, and the model's contacts came from loose sphere pairs (the caller replaces
+///    them). Tested only when that root sphere lies inside the other's root sphere.
+/// Contacts: up to min(maxContacts, 8) well-spread vertices of the inner body, all with the
+/// outer field's gradient at the inner body's root-sphere centre (or at the seed, if the centre
+/// is outside) as normal, each with its own depth -signed distance and error bound 0. Appends to
+/// `out` and sets `found`; returns the number of field queries made (at most 2 + 1 + 8), which
+/// the caller counts as tests.
+std::uint32_t containmentContacts(const CollisionBody& a, const CollisionBody& b, const Pose& xfAFromB,
+                                  std::uint32_t maxContacts, bool haveContacts, ContainmentScratch& scratch,
+                                  std::vector<Contact>& out, bool& found);
+
+}  // namespace clod::detail
