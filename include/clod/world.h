@@ -117,6 +117,12 @@ struct WorldSettings {
   /// body's bounding-box diagonal.
   double correctionFactor = 0.2;
   double slopRel = 0.002;
+  /// Manifold reuse: a pair whose last query finished (QueryResult::finished) keeps its manifold
+  /// without a new query while its two bodies have moved against each other, since that query,
+  /// by less than this fraction of the smaller body's diagonal (translation plus rotation angle
+  /// x diagonal); its contacts follow the bodies through their anchors. 0 queries every pair in
+  /// every substep (docs/dynamics.md, "Manifold reuse").
+  double reuseMotionRel = 0.001;
   /// Narrow-phase level cap for every pair (QuerySettings::maxLevel); default: no cap.
   std::uint32_t maxLevel = UINT32_MAX;
   /// At most this many substeps per step (>= 1).
@@ -148,6 +154,10 @@ struct PairReport {
   std::uint32_t level = 0;     ///< deepest level reached (QueryResult::maxLevel), last query
   bool finished = false;       ///< the last query reached the leaves
   bool skipped = false;        ///< budget gone before its turn in the last substep: old contacts used
+  /// Not queried in the last substep: its last query finished and the two bodies have since moved
+  /// against each other by less than WorldSettings::reuseMotionRel, so its manifold stands
+  /// (docs/dynamics.md, "Manifold reuse").
+  bool reused = false;
   /// Exact model: frontier pairs of the last query answered by the cfm (or dos) fallback instead
   /// of triangle tests (QueryResult::fallbackPairs); 0 at an unlimited budget.
   std::uint64_t fallbackPairs = 0;
@@ -173,6 +183,7 @@ struct StepReport {
   /// there is no time limit.
   double timeSpentMicros = 0.0;
   std::uint64_t pairsSkipped = 0;    ///< pair queries skipped for lack of budget, summed
+  std::uint64_t pairsReused = 0;     ///< pair queries saved by manifold reuse (PairReport::reused), summed
   std::uint64_t pairsInterrupted = 0;///< queries that stopped before the leaves, summed
   /// Exact model: frontier pairs answered by the cfm / dos fallback, summed over pairs and
   /// substeps (PairReport::fallbackPairs); 0 for the other models and at an unlimited budget.
