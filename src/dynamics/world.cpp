@@ -336,16 +336,22 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
           p->cache.clear();
           front = 1;
         }
-        if (perCell * front + 1 > remaining) {  // not affordable now
+        if (perCell * front + 1 <= remaining) {
+          // A pair may go over its share to sample its front once (round robin evens it out),
+          // never over what the substep has left.
+          const std::uint64_t grant = std::max(share, perCell * front + 1);
+          const std::uint64_t withinFront = std::min(front, grant - perCell * front);  // T <= F
+          const std::uint64_t beyondFront = grant / (1 + perCell);                     // T > F
+          share = std::max(withinFront, beyondFront > front ? beyondFront : 0);
+        } else if (front > 1) {  // not affordable now
           skip();
           continue;
+        } else {
+          // Not even the roots' answer (1 test + perCell) is affordable: a budget of 1-2 tests
+          // per frame at the default cost would never query a pair, and every dropped mesh fell
+          // through the ground. The roots' answer is given for what the substep has left.
+          share = 1;
         }
-        // A pair may go over its share to sample its front once (round robin evens it out), never
-        // over what the substep has left.
-        const std::uint64_t grant = std::max(share, perCell * front + 1);
-        const std::uint64_t withinFront = std::min(front, grant - perCell * front);  // T <= F
-        const std::uint64_t beyondFront = grant / (1 + perCell);                     // T > F
-        share = std::max(withinFront, beyondFront > front ? beyondFront : 0);
       }
       qs.budget = QueryBudget::tests(share);
     } else {
@@ -362,8 +368,10 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     }
     --left;
     queryContacts(*a.desc.shape, a.pose(), *bb.desc.shape, bb.pose(), qs, scratch, result, &p->cache);
-    const std::uint64_t cost = result.tests + perCell * result.frontier.size();
-    remaining -= std::min(remaining, cost);
+    // Charged as far as the substep has it left (only the roots' answer above may cost more).
+    const std::uint64_t fullCost = result.tests + perCell * result.frontier.size();
+    const std::uint64_t cost = limited ? std::min(remaining, fullCost) : fullCost;
+    remaining -= cost;
     report.budgetSpent += cost;
     report.testsSpent += result.tests;
     report.frontierPairs += result.frontier.size();
