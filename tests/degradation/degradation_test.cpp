@@ -1,16 +1,15 @@
 // Issue 17's scene categories against their analytic outcomes (include/clod/degradation.h): a
 // cut of the matrix that `clod experiment degradation` runs whole. The box categories (5-box
 // stack, twisted stack, 10-box pyramid, a box sliding to rest, a box resting on a 20 deg slope, a
-// box sliding down a 35 deg slope) with cfm and exact at 16, 256 tests per frame and unlimited,
+// box sliding down a 35 deg slope) with cfm, exact and contact-tree at 16, 256 tests per frame and unlimited,
 // 60 Hz, full durations: every criterion of the issue's point 1 (plausible), point 2 (the error
 // at more budget never worse beyond 10 % or 2 mm) and point 3 (real time). Oracle: the analytic
 // answers (rest, v^2 / 2 mu g, a t^2 / 2 with a = g (sin - mu cos)), in runScenario.
-// The mesh drops (bunny-1500, spot, fandisk onto a box) with cfm and exact at 16, 256 tests and
-// unlimited, 60 and 240 Hz: plausible (never more than 1 % of the diagonal below the ground, no
-// NaN, never through it; oracle: the ground's top face and the mesh's own vertices). Not
-// monotone: where a landing mesh comes to rest depends on its bounces (docs/dynamics.md).
-// The contact-tree model is not in the cut (docs/dynamics.md, "Known limits"); `clod experiment
-// degradation` measures it.
+// The mesh drops (bunny-1500, spot, fandisk onto a box) with the same models and budgets at 60
+// and 240 Hz: plausible (never more than 1 % of the diagonal below the ground, no NaN, never
+// through it; oracle: the ground's top face and the mesh's own vertices). Not monotone: where a
+// landing mesh comes to rest depends on its bounces (docs/dynamics.md).
+// The contact tree is in the cut for plausibility and real time, not for monotonicity (below).
 // Under the sanitizers: the stack and the slide with cfm at 16 tests, 1 s; one drop, 1 s.
 #include <gtest/gtest.h>
 
@@ -44,7 +43,8 @@ std::vector<Cell> cells() {
   }
   for (ScenarioKind kind : {ScenarioKind::kStack5, ScenarioKind::kStack5Twisted, ScenarioKind::kPyramid10,
                             ScenarioKind::kSlide, ScenarioKind::kSlopeRest, ScenarioKind::kSlopeSlide})
-    for (ContactModel model : {ContactModel::kCfm, ContactModel::kExact}) out.push_back({kind, model});
+    for (ContactModel model : {ContactModel::kCfm, ContactModel::kExact, ContactModel::kContactTree})
+      out.push_back({kind, model});
   return out;
 }
 
@@ -73,7 +73,10 @@ TEST_P(Degradation, PlausibleAtEveryBudgetAndNeverWorseWithMore) {
     }
     errors.push_back(o.error);
   }
-  // Budgets in increasing order (unlimited last): each step up may not be worse.
+  // Budgets in increasing order (unlimited last): each step up may not be worse. Not asserted for
+  // the contact tree: its slide and slopes stay plausible but are not monotone (2-20 mm more
+  // error at 256 tests than at 16; docs/dynamics.md, "Known limits").
+  if (cell.model == ContactModel::kContactTree) return;
   for (std::size_t i = 0; i + 1 < errors.size(); ++i)
     EXPECT_TRUE(degradesMonotonically(errors[i], errors[i + 1]))
         << scenarioName(cell.kind) << " " << contactModelName(cell.model) << ": error " << errors[i] << " at budget "
@@ -86,7 +89,8 @@ std::vector<Cell> dropCells() {
   if (test::sanitizerRun()) return {{ScenarioKind::kDropBunny, ContactModel::kCfm}};
   std::vector<Cell> out;
   for (ScenarioKind kind : {ScenarioKind::kDropBunny, ScenarioKind::kDropSpot, ScenarioKind::kDropFandisk})
-    for (ContactModel model : {ContactModel::kCfm, ContactModel::kExact}) out.push_back({kind, model});
+    for (ContactModel model : {ContactModel::kCfm, ContactModel::kExact, ContactModel::kContactTree})
+      out.push_back({kind, model});
   return out;
 }
 
