@@ -104,6 +104,9 @@ public:
   /// every face a patch holds is a face of the body, and the depths of face-on-face contacts
   /// between patches are exact.
   bool isConvexPolyhedron() const noexcept { return convexPolyhedron_; }
+  /// True when every edge of the mesh is shared by exactly two triangles (MeshTopology::closed):
+  /// the body has an inside (the containment answer, docs/narrow-phase.md).
+  bool isClosed() const noexcept { return closed_; }
   static constexpr std::uint32_t kMaxConvexCheckTriangles = 4096;
 
   /// Bounding-box diagonal of the mesh: the unit of this body's relative tolerances.
@@ -134,6 +137,7 @@ private:
   std::vector<double> supportSlack_;
   double diagonal_ = 0.0;
   bool convexPolyhedron_ = false;     // closed and convex (isConvexPolyhedron)
+  bool closed_ = false;               // every edge shared by exactly two triangles (isClosed)
   std::size_t usedVertexCount_ = 0;   // distinct vertices referenced by triangles
   std::string name_;
 };

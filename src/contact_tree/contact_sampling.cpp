@@ -135,6 +135,7 @@ struct SlideFrame {
   const ContactTree& treeO;
   const ContactCell& cellO;
   const Pose& xfOFromS;
+  Eigen::Matrix3d sFromO;  // rotation of O's frame into S's (for O's gradients)
   std::uint32_t maxDepth;
   double marginAbs;
   bool project;     // land each step on S's surface (inner non-flat cell)
@@ -142,9 +143,8 @@ struct SlideFrame {
 };
 
 bool slideIntoOther(const SlideFrame& fr, Vec3& pS, SurfacePoint& surface, Vec3& pO, ContactFieldSample& f) {
-  const Eigen::Matrix3d sFromO = fr.xfOFromS.rotation.conjugate().toRotationMatrix();
   for (int step = 0; step < kSlideSteps; ++step) {
-    const Vec3 g = sFromO * f.gradient;
+    const Vec3 g = fr.sFromO * f.gradient;
     const Vec3 tangent = g - g.dot(surface.normal) * surface.normal;
     const double slope = tangent.norm();
     if (!(slope > 1e-6)) return false;  // O's field does not fall along S's surface here
@@ -250,7 +250,8 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
   const int layers = settings.offSurfaceDepthRel > 0.0 ? 2 : 1;
   const int iFirst = spread ? 0 : i0 - reach, jFirst = spread ? 0 : j0 - reach;
   const Pose xfOFromS = xfWorldFromO.inverse() * xfWorldFromS;
-  const SlideFrame slide{treeS, cellS, treeO, cellO, xfOFromS, settings.maxDepth, settings.marginAbs, project,
+  const SlideFrame slide{treeS, cellS, treeO, cellO, xfOFromS, xfOFromS.rotation.conjugate().toRotationMatrix(),
+                         settings.maxDepth, settings.marginAbs, project,
                          spread ? std::max(spreadStepU, spreadStepV) : spacing};
   for (int i = iFirst; i <= i0 + reach; ++i) {
     for (int j = jFirst; j <= j0 + reach; ++j) {

@@ -149,14 +149,15 @@ void CollisionBody::classifyConvexPolyhedron(std::span<const EdgeRef> sortedEdge
   std::sort(used.begin(), used.end());
   used.erase(std::unique(used.begin(), used.end()), used.end());
   usedVertexCount_ = used.size();
-  if (mesh_.triangleCount() > kMaxConvexCheckTriangles || mesh_.triangleCount() == 0) return;
   // Closed: every edge is shared by exactly two triangles.
-  for (std::size_t i = 0; i < sortedEdges.size();) {
+  closed_ = mesh_.triangleCount() > 0;
+  for (std::size_t i = 0; i < sortedEdges.size() && closed_;) {
     std::size_t j = i;
     while (j < sortedEdges.size() && sortedEdges[j].v0 == sortedEdges[i].v0 && sortedEdges[j].v1 == sortedEdges[i].v1) ++j;
-    if (j - i != 2) return;
+    closed_ = j - i == 2;
     i = j;
   }
+  if (!closed_ || mesh_.triangleCount() > kMaxConvexCheckTriangles) return;
   const double tolerance = 1e-9 * diagonal_;  // rounding of the vertex coordinates
   for (std::uint32_t t = 0; t < mesh_.triangleCount(); ++t) {
     const Vec3 n = mesh_.triangleNormal(t);

@@ -5,22 +5,10 @@
 #include <cmath>
 #include <limits>
 
-#include "clod/mesh_topology.h"
 #include "clod/proximity.h"
 
 namespace clod::detail {
 namespace {
-
-std::uint64_t hashTriangles(const TriangleMesh& mesh) {
-  std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the index words
-  for (const Triangle& t : mesh.triangles) {
-    for (std::uint32_t v : t) {
-      h ^= v;
-      h *= 1099511628211ull;
-    }
-  }
-  return h;
-}
 
 // Best-first search of the sphere-tree's leaves for the closest point to p. A leaf's sphere
 // bounds the part of each listed triangle assigned to it, and those parts cover the surface, so
@@ -139,23 +127,6 @@ FieldValue exactBodyField(const CollisionBody& body, const Vec3& pLocal, Contain
   return f;
 }
 
-bool bodyIsClosed(const CollisionBody& body, ContainmentScratch& scratch) {
-  const TriangleMesh& mesh = body.mesh();
-  const std::uint64_t hash = hashTriangles(mesh);
-  for (const auto& e : scratch.closedCache) {
-    if (e.hash == hash && e.count == mesh.triangles.size()) return e.closed;
-  }
-  const bool closed = MeshTopology(mesh).closed();
-  const ContainmentScratch::ClosedEntry entry{hash, mesh.triangles.size(), closed};
-  if (scratch.closedCache.size() < ContainmentScratch::kClosedCacheSize) {
-    scratch.closedCache.push_back(entry);
-  } else {
-    scratch.closedCache[scratch.closedCacheNext] = entry;
-    scratch.closedCacheNext = (scratch.closedCacheNext + 1) % ContainmentScratch::kClosedCacheSize;
-  }
-  return closed;
-}
-
 namespace {
 
 // The vertices of the inner body that stand for it: its root sphere's patch or support vertices
@@ -206,8 +177,8 @@ std::uint32_t innerContacts(const CollisionBody& inner, const CollisionBody& out
     atSeed = exactBodyField(outer, seedOuter, s);
     if (!(atSeed.distance < 0.0)) return queries;
   }
-  // Only a closed body has an inside (checked last: it is the expensive part on a cache miss).
-  if (!bodyIsClosed(outer, s)) return queries;
+  // Only a closed body has an inside.
+  if (!outer.isClosed()) return queries;
 
   // One normal for all contacts: the outer field's gradient at the inner body's root-sphere
   // centre (inside the outer body, as the seed is), else at the seed. Each point's own gradient

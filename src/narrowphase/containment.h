@@ -14,19 +14,10 @@
 
 namespace clod::detail {
 
-/// Working memory of containmentContacts (reused: no allocation once grown, except the
-/// closedness check of a mesh the scratch has not seen yet).
+/// Working memory of containmentContacts (reused: no allocation once grown).
 struct ContainmentScratch {
   std::vector<std::pair<double, std::uint32_t>> heap;  // best-first sphere-tree search
   std::vector<std::uint32_t> triangles;                // triangles around a closest vertex/edge
-  struct ClosedEntry {
-    std::uint64_t hash;  // of the triangle index array (closedness depends on nothing else)
-    std::uint64_t count;
-    bool closed;
-  };
-  std::vector<ClosedEntry> closedCache;  // at most kClosedCacheSize entries, oldest replaced
-  std::uint32_t closedCacheNext = 0;
-  static constexpr std::uint32_t kClosedCacheSize = 64;
 };
 
 /// Signed distance of a body's surface at p (body frame), negative inside, with the field's
@@ -44,9 +35,6 @@ struct FieldValue {
 };
 FieldValue exactBodyField(const CollisionBody& body, const Vec3& pLocal, ContainmentScratch& scratch);
 
-/// True when the body's mesh is closed (every edge shared by exactly two triangles,
-/// MeshTopology::closed). Cached in the scratch by a hash of the triangle indices.
-bool bodyIsClosed(const CollisionBody& body, ContainmentScratch& scratch);
 
 /// Containment contacts (A's frame, normal from B toward A) when A lies wholly inside B or B
 /// inside A. Two triggers:

@@ -129,6 +129,21 @@ TEST(World, RestitutionBelowOneLosesKineticEnergy) {
   EXPECT_LE((c.pAfter - c.pBefore).norm(), 1e-9 * c.pBefore.norm());
 }
 
+// The box-drop scene: a unit cube of 1 kg (body 1) 1.5 m above the centre of `slab` (body 0,
+// static), with the given model and test budget per frame.
+World boxDropWorld(const std::shared_ptr<const CollisionBody>& slab, ContactModel model, std::uint64_t budget) {
+  WorldSettings ws;
+  ws.model = model;
+  ws.budgetTests = budget;
+  World world(ws);
+  addStaticGround(world, slab, "ground");
+  RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
+  box.name = "box";
+  box.position = Vec3(0.1, -0.05, 1.5);
+  world.addBody(box);
+  return world;
+}
+
 TEST(World, BoxDroppedFlatComesToRestFlatWithEveryModelAndBudget) {
   const auto slab = bakeShape(makeBox(Vec3(2.0, 2.0, 0.25)));
   for (ContactModel model : {ContactModel::kCfm, ContactModel::kContactTree, ContactModel::kExact}) {
@@ -136,15 +151,7 @@ TEST(World, BoxDroppedFlatComesToRestFlatWithEveryModelAndBudget) {
       // Under sanitizers the smallest and the unlimited budget: the middle ones take the same code
       // paths (an interrupted and a finished query) and cost two minutes there.
       if (sanitizerRun() && (budget == 64 || budget == 256)) continue;
-      WorldSettings ws;
-      ws.model = model;
-      ws.budgetTests = budget;
-      World world(ws);
-      addStaticGround(world, slab, "ground");
-      RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
-      box.name = "box";
-      box.position = Vec3(0.1, -0.05, 1.5);
-      world.addBody(box);
+      World world = boxDropWorld(slab, model, budget);
       for (int i = 0; i < 120; ++i) world.step(1.0 / 60.0);  // 2 s
       const RigidBodyState s = world.state(1);
       const std::string what = std::string(contactModelName(model)) + " budget " + std::to_string(budget);
@@ -169,14 +176,7 @@ TEST(World, TinyBudgetStillAnswersFromTheRootsAndNothingFallsThrough) {
   const auto slab = bakeShape(makeBox(Vec3(2.0, 2.0, 0.25)));
   for (ContactModel model : {ContactModel::kCfm, ContactModel::kContactTree, ContactModel::kExact}) {
     for (std::uint64_t budget : {std::uint64_t(1), std::uint64_t(2)}) {
-      WorldSettings ws;
-      ws.model = model;
-      ws.budgetTests = budget;
-      World world(ws);
-      addStaticGround(world, slab, "ground");
-      RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
-      box.position = Vec3(0.1, -0.05, 1.5);
-      world.addBody(box);
+      World world = boxDropWorld(slab, model, budget);
       std::uint64_t spent = 0;
       for (int i = 0; i < 90; ++i) {
         const StepReport& r = world.step(1.0 / 60.0);
