@@ -321,8 +321,14 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       --left;
       continue;
     }
+    // A pair without contacts may be arriving (an empty answer, finished or not, says nothing
+    // about the next substep): skipping it leaves it without contacts while it closes in (a mesh dropped at
+    // 60 Hz under a 50 us budget fell a whole frame into the ground after the impact substep's one
+    // query used the frame's time). It is never skipped but gets the roots' answer, whatever the
+    // substep has left: a budget may run over by one roots' answer per such pair and substep.
+    const bool blind = p->contacts.empty();
     if (limited) {
-      if (remaining == 0) {
+      if (remaining == 0 && !blind) {
         skip();
         continue;
       }
@@ -343,10 +349,11 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
           const std::uint64_t withinFront = std::min(front, grant - perCell * front);  // T <= F
           const std::uint64_t beyondFront = grant / (1 + perCell);                     // T > F
           share = std::max(withinFront, beyondFront > front ? beyondFront : 0);
-        } else if (front > 1) {  // not affordable now
+        } else if (front > 1 && !blind) {  // not affordable now
           skip();
           continue;
         } else {
+          if (front > 1) p->cache.clear();  // a blind pair's roots' answer
           // Not even the roots' answer (1 test + perCell) is affordable: a budget of 1-2 tests
           // per frame at the default cost would never query a pair, and every dropped mesh fell
           // through the ground. The roots' answer is given for what the substep has left.
@@ -362,8 +369,12 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       const QueryBudget::TimePoint now = timeUp ? substepDeadline : s.clock();
       if (now >= substepDeadline) {
         timeUp = true;
-        skip();
-        continue;
+        if (!blind) {
+          skip();
+          continue;
+        }
+        p->cache.clear();
+        qs.budget = QueryBudget::tests(1);
       }
     }
     --left;
@@ -936,7 +947,9 @@ const StepReport& World::step(double dt) {
   }
   if (timedStep && m.report.budgetSpent > 0) {
     const double measured = m.report.timeSpentMicros / static_cast<double>(m.report.budgetSpent);
-    m.microsPerUnit = 0.75 * m.microsPerUnit + 0.25 * std::max(measured, 1e-6);
+    // A step the OS preempted measures milliseconds for a few units; clipped to 4x the estimate,
+    // one such step cannot starve the next dozen (one 1 ms step made the estimate 8x too high).
+    m.microsPerUnit = 0.75 * m.microsPerUnit + 0.25 * std::clamp(measured, 1e-6, 4.0 * m.microsPerUnit);
   }
   for (auto& [key, pr] : m.pairReports) {
     auto it = m.pairs.find(key);

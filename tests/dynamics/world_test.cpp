@@ -192,6 +192,40 @@ TEST(World, TinyBudgetStillAnswersFromTheRootsAndNothingFallsThrough) {
   }
 }
 
+// A time budget the narrow phase always overruns (a clock that advances 1 ms per read: every
+// substep's share of a 50 us budget is gone before its first query) still answers a pair that
+// has no contacts yet: it may be arriving. Before, such a pair was skipped for the rest of the
+// step, and a box dropped at 60 Hz sank the frame's remaining fall into the slab. Oracle: the
+// slab's top face (z = 0.25); a 1 m box's bottom at most 1 % of its diagonal below it.
+QueryBudget::TimePoint millisecondPerRead() {
+  static QueryBudget::TimePoint t{};
+  t += std::chrono::milliseconds(1);
+  return t;
+}
+
+TEST(World, ATimeBudgetStillAnswersPairsWithoutContactsSoNothingSinks) {
+  const auto slab = bakeShape(makeBox(Vec3(2.0, 2.0, 0.25)));
+  for (ContactModel model : {ContactModel::kCfm, ContactModel::kContactTree, ContactModel::kExact}) {
+    WorldSettings ws;
+    ws.model = model;
+    ws.budgetMicros = 50.0;
+    ws.clock = &millisecondPerRead;
+    World world(ws);
+    addStaticGround(world, slab, "ground");
+    RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
+    box.position = Vec3(0.1, -0.05, 1.5);
+    world.addBody(box);
+    double lowest = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < 90; ++i) {
+      world.step(1.0 / 60.0);
+      lowest = std::min(lowest, world.state(1).position.z() - 0.5);
+    }
+    const std::string what(contactModelName(model));
+    EXPECT_GT(lowest, 0.25 - 0.01 * std::sqrt(3.0)) << what;
+    EXPECT_LT(world.state(1).velocity.norm(), 0.05) << what;
+  }
+}
+
 // Manifold reuse (docs/dynamics.md): a box resting on a slab is not queried again once its
 // finished manifold holds, while a box sliding at 2 m/s (3 cm per frame, far beyond 0.1 % of its
 // diagonal) is queried in every substep; both end as without reuse (reuseMotionRel 0): at rest,
