@@ -81,6 +81,10 @@ public:
             supportVertexOffsets_[sphere + 1] - supportVertexOffsets_[sphere]};
   }
   double sphereSupportSlack(std::uint32_t sphere) const noexcept { return supportSlack_[sphere]; }
+  /// Outward unit normal at a mesh vertex: the angle-weighted mean of its triangles' normals
+  /// (zero for an unused vertex). A curved patch's vertex pressed into a convex body leaves it
+  /// through the face this normal faces (docs/narrow-phase.md, "Curved patches").
+  Vec3 vertexNormal(std::uint32_t vertex) const noexcept { return vertexNormals_[vertex].cast<double>(); }
   /// For a sphere with patch vertices: the distinct directions (unit, sign arbitrary) of the body
   /// edges among its triangles' edges (sharp: the neighbour's normal differs; or a border), when
   /// there are at most kMaxSphereEdgeDirections; empty otherwise. The cfm model crosses them with
@@ -120,6 +124,7 @@ private:
     std::uint32_t v0, v1, triangle;
   };
   void classifyConvexPolyhedron(std::span<const EdgeRef> sortedEdges);
+  void computeVertexNormals();
 
   TriangleMesh mesh_;
   SphereTree tree_;
@@ -135,6 +140,7 @@ private:
   std::vector<std::uint32_t> supportVertexOffsets_;
   std::vector<std::uint32_t> supportVertices_;
   std::vector<double> supportSlack_;
+  std::vector<Vec3f> vertexNormals_;
   double diagonal_ = 0.0;
   bool convexPolyhedron_ = false;     // closed and convex (isConvexPolyhedron)
   bool closed_ = false;               // every edge shared by exactly two triangles (isClosed)

@@ -1,6 +1,8 @@
 #include "clod/collision_body.h"
 
 #include <algorithm>
+#include <array>
+#include <cstdint>
 #include <cmath>
 #include <string>
 
@@ -138,6 +140,44 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree) : mesh_(std::mo
     supportVertexOffsets_.push_back(static_cast<std::uint32_t>(supportVertices_.size()));
   }
   classifyConvexPolyhedron(edges);
+  computeVertexNormals();
+}
+
+// Vertex normals weighted by the triangles' angles at the vertex (Thuermer and Wuethrich 1998:
+// independent of how the faces are triangulated -- a tessellated box's corner faces its three
+// faces alike), summed over every copy of a position: a mesh stored with one vertex copy per
+// face would otherwise give an edge's vertex its own face's normal, and a box's side-face vertex
+// pressed into a floor was pushed out sideways.
+void CollisionBody::computeVertexNormals() {
+  // Copies agree to rounding: positions on a lattice of 1e-9 of the diagonal count as one.
+  const auto& p = mesh_.vertices;
+  const double cell = 1e-9 * std::max(diagonal_, 1e-300);
+  std::vector<std::array<std::int64_t, 3>> key(p.size());
+  for (std::size_t v = 0; v < p.size(); ++v)
+    for (int a = 0; a < 3; ++a) key[v][a] = static_cast<std::int64_t>(std::llround(p[v][a] / cell));
+  std::vector<std::uint32_t> order(p.size());
+  for (std::uint32_t v = 0; v < order.size(); ++v) order[v] = v;
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return key[a] < key[b]; });
+  std::vector<std::uint32_t> position(order.size());  // index of the position's first copy
+  for (std::size_t i = 0; i < order.size(); ++i)
+    position[order[i]] = (i > 0 && key[order[i]] == key[order[i - 1]]) ? position[order[i - 1]] : order[i];
+  std::vector<Vec3> sums(p.size(), Vec3::Zero());
+  for (std::uint32_t t = 0; t < mesh_.triangleCount(); ++t) {
+    const Vec3 areaNormal = (mesh_.corner(t, 1) - mesh_.corner(t, 0)).cross(mesh_.corner(t, 2) - mesh_.corner(t, 0));
+    const double area2 = areaNormal.norm();
+    if (!(area2 > 0.0)) continue;
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 e1 = mesh_.corner(t, (k + 1) % 3) - mesh_.corner(t, k);
+      const Vec3 e2 = mesh_.corner(t, (k + 2) % 3) - mesh_.corner(t, k);
+      sums[position[mesh_.triangles[t][k]]] += std::atan2(e1.cross(e2).norm(), e1.dot(e2)) * areaNormal / area2;
+    }
+  }
+  vertexNormals_.resize(p.size());
+  for (std::size_t v = 0; v < p.size(); ++v) {
+    const Vec3& sum = sums[position[v]];
+    const double length = sum.norm();
+    vertexNormals_[v] = length > 0.0 ? Vec3f((sum / length).cast<float>()) : Vec3f::Zero();
+  }
 }
 
 // A closed mesh all of whose vertices lie behind every triangle's plane is a convex polyhedron.

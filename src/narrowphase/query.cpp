@@ -819,28 +819,47 @@ bool facedPatchContacts(const PatchSide& sideA, const PatchSide& sideB, const Co
 // Returns false when it added nothing.
 bool vertexOnFaceContacts(const PatchSide& patch, const PatchSide& faceted, const Vec3& toward, const Contact& c,
                           std::vector<Contact>& out) {
-  detail::FacePlane plane;
-  std::array<Vec3, 32> corners;
-  std::size_t cornerCount = 0;
-  if (!facingFace(faceted, toward, plane, corners, cornerCount)) return false;
-  const std::span<const Vec3f> faces = faceted.body.sphereFaceNormals(faceted.sphere);
+  // A curved patch's vertex inside a convex body is pushed out through the nearest face its own
+  // surface normal faces (within 60 degrees: an edge's or a corner's vertex of a tessellated box
+  // faces two or three). The face the
+  // pair's axis faces can be a side face: a slab's patch holding flat ground and the foot of a
+  // bump, seen from a box sliding toward the bump, overlaps the box least along the box's front
+  // face, and its vertices pushed the box back through that face (it then jumped the bump, 767 mm
+  // rms off the exact track). Inside: behind every face of the whole body (the root's patch; the
+  // leaf's faces if the root has too many).
+  constexpr double kMinFacingCos = 0.5;  // cos 60 deg
+  const std::uint32_t root = 0;
+  const bool whole = !faceted.body.sphereFaceNormals(root).empty();
+  const PatchSide body{faceted.body, whole ? root : faceted.sphere, true, faceted.centre, faceted.radius, faceted.rotToA, faceted.shift};
+  const std::span<const Vec3f> faces = faceted.body.sphereFaceNormals(body.sphere);
   std::array<std::pair<Vec3, double>, CollisionBody::kMaxSphereFaceNormals> halfSpaces;
   for (std::size_t k = 0; k < faces.size(); ++k) {
     const Vec3 f = faceted.rotToA ? Vec3(*faceted.rotToA * faces[k].cast<double>()) : Vec3(faces[k].cast<double>());
-    halfSpaces[k] = {f, faceted.support(f)};
+    halfSpaces[k] = {f, body.support(f)};
   }
   const double tolerance = 1e-9 * (patch.body.diagonal() + faceted.body.diagonal());
+  const bool facetedIsB = toward.dot(c.normal) > 0.0;
   const std::size_t before = out.size();
   for (std::uint32_t id : patch.body.sphereSupportVertices(patch.sphere)) {
     const Vec3 v = patch.toA(patch.body.mesh().vertices[id]);
-    const double depth = plane.offset - plane.normal.dot(v);
-    if (!(depth > tolerance)) continue;
+    const Vec3 normal = patch.rotToA ? Vec3(*patch.rotToA * patch.body.vertexNormal(id)) : patch.body.vertexNormal(id);
     bool inside = true;
-    for (std::size_t k = 0; k < faces.size() && inside; ++k) inside = halfSpaces[k].first.dot(v) <= halfSpaces[k].second + tolerance;
+    std::size_t pressed = faces.size(), nearest = 0;
+    double depth = std::numeric_limits<double>::infinity(), nearestDepth = depth;
+    for (std::size_t k = 0; k < faces.size() && inside; ++k) {
+      const double d = halfSpaces[k].second - halfSpaces[k].first.dot(v);
+      inside = d > tolerance;
+      if (-halfSpaces[k].first.dot(normal) >= kMinFacingCos && d < depth) depth = d, pressed = k;
+      if (d < nearestDepth) nearestDepth = d, nearest = k;
+    }
     if (!inside) continue;
+    // No face it faces, or one deeper than the patch is large (an open mesh's rim vertex, whose
+    // normal lies along the floor, faced the floor's side face 2 m away): the nearest face.
+    if (pressed == faces.size() || depth > patch.radius) pressed = nearest, depth = nearestDepth;
+    const Vec3& exit = halfSpaces[pressed].first;
     Contact ci = c;
-    ci.normal = toward.dot(c.normal) > 0.0 ? plane.normal : Vec3(-plane.normal);
-    ci.point = v + 0.5 * depth * plane.normal;
+    ci.normal = facetedIsB ? exit : Vec3(-exit);
+    ci.point = v + 0.5 * depth * exit;
     ci.depth = depth;
     ci.errorBound = 0.0;
     out.push_back(ci);
