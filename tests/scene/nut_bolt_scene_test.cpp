@@ -6,7 +6,7 @@
 // from the generator's clearance, and exact signed distances between the meshes at the poses
 // the world reached (proximity.h). docs/engines.md, "Nut on a bolt", has the numbers.
 //
-// Cost: the exact model on ~3,600 triangles in tight contact takes ~7 ms per substep query
+// Cost: the exact model on ~3,600 triangles in tight contact takes ~5 ms per substep query
 // (2-3 substeps per step), so 0.35 s simulated is ~3 s in Release on one core. Under the
 // sanitizers (3-10x slower) the test is skipped with a message.
 #include <algorithm>
