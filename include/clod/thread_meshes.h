@@ -66,8 +66,8 @@ void validateIsoThread(const IsoThread& thread);
 /// A threaded rod: the external thread of `thread` with helicoidal ends (see the top), from
 /// z = 0 (the bottom ramp starts at angle 0) to z = (turns + 1) pitch (where the top ramp ends),
 /// exactly `turns` pitches long at every angle. turns in [1, 4096], segmentsPerTurn in [6, 4096].
-/// 4 turns + 4 rows of segmentsPerTurn vertices on the thread plus 2 (segmentsPerTurn + 1) on
-/// the axis; 8 turns segmentsPerTurn thread triangles plus the ends.
+/// n = segmentsPerTurn: (4 turns + 1) n + 4 vertices on the thread plus 2 (n + 1) on the axis;
+/// 8 turns n triangles on the thread, 2 n on each ramp and n + 4 on each step face.
 /// Volume of the smooth part: turns x solidVolumePerPitch(); the mesh's vertices lie on that
 /// surface and its facets inside it (a polygon of segmentsPerTurn sides instead of a circle).
 /// O(triangles).
@@ -78,7 +78,9 @@ TriangleMesh makeThreadedRod(const IsoThread& thread, std::uint32_t turns, std::
 /// rod's thread when placed at z = k pitch, unturned), outside a regular hexagonal prism
 /// `acrossFlats` wide with corners at angles 0, 60, ... degrees. segmentsPerTurn must be a
 /// multiple of 6 (the corners are then sample angles and every side quad is flat), in
-/// [6, 4096]; acrossFlats / 2 must exceed the thread's major radius + clearance. Volume of the
+/// [6, 4096]; acrossFlats / 2 must exceed the thread's major radius + clearance. n =
+/// segmentsPerTurn: (4 turns + 1) n + 4 thread vertices and (turns + 1) n + 1 on the hexagon;
+/// 8 turns n + 2 turns n triangles on the two walls, 2 n on each ramp, 5 on each step. Volume of the
 /// smooth part: turns x (pitch x hexagon area - solidVolumePerPitch(radialClearance)).
 /// O(triangles).
 TriangleMesh makeHexNut(const IsoThread& thread, double radialClearance, double acrossFlats, std::uint32_t turns,

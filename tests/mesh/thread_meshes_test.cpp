@@ -72,6 +72,13 @@ TEST_F(ThreadMeshParts, BoltAndNutAreClosedManifoldAndOutward) {
   EXPECT_EQ(meshes[1].name, "nut");
   expectClosedOrientedGenus(bolt, 0);
   expectClosedOrientedGenus(nut, 1);
+  // Counts from the construction (thread_meshes.h): rows of helix samples, the step faces'
+  // extra rows, the ramps and step faces.
+  const std::uint32_t n = parts.segmentsPerTurn, tb = parts.boltTurns, tn = parts.nutTurns;
+  EXPECT_EQ(bolt.vertexCount(), (4 * tb + 1) * n + 4 + 2 * (n + 1));
+  EXPECT_EQ(bolt.triangleCount(), 8 * tb * n + 2 * 2 * n + 2 * (n + 4));
+  EXPECT_EQ(nut.vertexCount(), (4 * tn + 1) * n + 4 + (tn + 1) * n + 1);
+  EXPECT_EQ(nut.triangleCount(), 8 * tn * n + 2 * tn * n + 2 * 2 * n + 2 * 5);
   // Moderate sizes, so that the scenes' tests run in seconds.
   EXPECT_LT(bolt.triangleCount(), 3000u);
   EXPECT_LT(nut.triangleCount(), 2000u);
