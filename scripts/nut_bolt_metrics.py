@@ -6,7 +6,13 @@ latter pass DIR/clod or DIR/mujoco): turns about the bolt's axis, advance per tu
 play is +-87 um), lateral shift and tilt, microseconds per step (median and p99 of the run's
 step times) and contacts per step (the one nut-bolt pair).
 
-usage: nut_bolt_metrics.py DIR [--origin-z Z] [--pitch P]
+usage: nut_bolt_metrics.py DIR [--origin-z Z] [--pitch P] [--screw-ratios S]
+
+--screw-ratios S also prints, for the contacts of the last S seconds, the screw ratio
+(p x n)_z / n_z of each contact (p its point, n its normal, the bolt's axis being z): on the
+flanks of a helix of pitch P it is +-P / 2 pi at every point (0.318 mm for M16 x 2); contacts
+whose ratios have both signs can hold the nut's weight without turning it (docs/engines.md,
+"Why the nut jams from rest"), and the radial / tangential / axial parts of the normals.
 
 The trajectory holds the pose of what the run calls the nut: its mesh frame (clod simulate) or
 its geom, which MuJoCo puts at the mesh's centroid (clod mujoco). Both move rigidly with the
@@ -37,6 +43,7 @@ def main():
     parser.add_argument("dir")
     parser.add_argument("--origin-z", type=float, default=0.018)
     parser.add_argument("--pitch", type=float, default=0.002)
+    parser.add_argument("--screw-ratios", type=float, default=0.0)
     args = parser.parse_args()
     rows = [r for r in csv.DictReader(open(args.dir + "/trajectory.csv")) if r["body"] == "nut"]
     key = ("qw", "qx", "qy", "qz")
@@ -73,6 +80,27 @@ def main():
           f"{max(off) * 1e6:.1f}] um, lateral max {max(math.hypot(s[1][0], s[1][1]) for s in samples) * 1e6:.1f} um, "
           f"tilt max {max(s[3] for s in samples):.3f} deg; {statistics.median(steps):.0f} us per step median, "
           f"{sorted(steps)[int(0.99 * (len(steps) - 1))]:.0f} p99; {perStep:.2f} contacts per step")
+    if args.screw_ratios > 0:
+        dt = samples[1][0] - samples[0][0]
+        first = int(round((end[0] - args.screw_ratios) / dt))
+        ratios, tangential = [], []
+        for r in csv.DictReader(open(args.dir + "/contacts.csv")):
+            if int(r["step"]) < first:
+                continue
+            x, y = float(r["px"]), float(r["py"])
+            nx, ny, nz = float(r["nx"]), float(r["ny"]), float(r["nz"])
+            if abs(nz) < 1e-9:
+                continue
+            ratios.append((x * ny - y * nx) / nz)
+            radius = math.hypot(x, y)
+            tangential.append((-nx * y + ny * x) / radius)
+        ratios.sort()
+        tangential.sort()
+        if ratios:
+            print(f"screw ratio (p x n)_z / n_z over {len(ratios)} contacts of the last {args.screw_ratios} s: "
+                  f"min {ratios[0] * 1e3:.3f} mm, median {ratios[len(ratios) // 2] * 1e3:.3f} mm, max {ratios[-1] * 1e3:.3f} mm "
+                  f"(a flank's: +-{args.pitch / (2 * math.pi) * 1e3:.3f} mm); tangential part of the normals "
+                  f"{tangential[0]:.3f} .. {tangential[-1]:.3f}")
 
 
 if __name__ == "__main__":
