@@ -81,7 +81,8 @@ public:
   void addStrip(std::uint32_t surface, bool outward) {
     for (std::uint32_t l = 0; l < rowsOf(surface); ++l)
       for (std::uint32_t m = 0; m < n_; ++m) {
-        // Split along the diagonal that follows the helix of the lower row's next sample.
+        // a, b along row l (the helix), d, c along row l + 1; split along a-c. A flank quad is not
+        // quite flat (its rows lie at different radii): its two triangles fold by under a degree.
         const std::uint32_t a = id(surface, l, m), b = id(surface, l, m + 1), c = id(surface, l + 1, m + 1),
                             d = id(surface, l + 1, m);
         if (outward)
