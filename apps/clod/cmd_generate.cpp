@@ -1,6 +1,8 @@
 // clod generate SET -o OUTDIR: writes a set of generated part meshes as OBJ files (metres).
 //   mujoco-demo  the parts of scenes/mujoco/ (part_meshes.h, demoPartMeshes): ring.obj,
 //                ring_peg.obj, bowl.obj, holed_block.obj, hole_peg.obj
+//   nut-bolt     the M16 x 2 bolt and nut of the nut-on-bolt scenes (thread_meshes.h,
+//                nutBoltMeshes): bolt.obj, nut.obj
 // The files are what the scenes load; tests/mujoco checks that the committed ones equal this
 // command's output. An unknown set is bad usage (exit 2).
 #include <filesystem>
@@ -11,6 +13,7 @@
 #include "clod/atomic_file.h"
 #include "clod/error.h"
 #include "clod/part_meshes.h"
+#include "clod/thread_meshes.h"
 #include "command.h"
 
 namespace clod::cli {
@@ -23,9 +26,12 @@ struct GenerateOptions {
 
 int runGenerate(const GenerateOptions& o) {
   std::vector<NamedMesh> parts;
-  if (o.set == "mujoco-demo") parts = demoPartMeshes();
+  if (o.set == "mujoco-demo")
+    parts = demoPartMeshes();
+  else if (o.set == "nut-bolt")
+    parts = nutBoltMeshes();
   else
-    throw Error(ErrorCode::kInvalidArgument, "generate: unknown set '" + o.set + "' (sets: mujoco-demo)");
+    throw Error(ErrorCode::kInvalidArgument, "generate: unknown set '" + o.set + "' (sets: mujoco-demo, nut-bolt)");
   const std::filesystem::path out(o.outDir);
   std::error_code ec;
   std::filesystem::create_directories(out, ec);
@@ -41,8 +47,8 @@ int runGenerate(const GenerateOptions& o) {
 
 const CommandRegistration kRegistration("generate", [](CLI::App& app) {
   auto options = std::make_shared<GenerateOptions>();
-  CLI::App* sub = app.add_subcommand("generate", "Write generated part meshes (OBJ): mujoco-demo");
-  sub->add_option("set", options->set, "Which parts: mujoco-demo")->required();
+  CLI::App* sub = app.add_subcommand("generate", "Write generated part meshes (OBJ): mujoco-demo, nut-bolt");
+  sub->add_option("set", options->set, "Which parts: mujoco-demo, nut-bolt")->required();
   sub->add_option("-o,--output", options->outDir, "Output directory")->required();
   return [options] { return runGenerate(*options); };
 });

@@ -11,7 +11,9 @@
 // contact, normal from body_b toward body_a (clod's convention, contact.h: MuJoCo's frame normal
 // negated), depth = -dist, level 0. Duration: --duration, else the model's
 // <custom><numeric name="clod_duration" data="S"/></custom>, else 2 s. Summary extras:
-// "collider" (mujoco or clod), "final": positions of the moving geoms.
+// "collider" (mujoco or clod), "final": positions of the moving geoms. The sphere-trees clod
+// bakes have ColliderSettings' default depth, or the model's
+// <numeric name="clod_sphere_tree_depth" data="D"/> (1..8; the nut-on-bolt demo uses 4).
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -286,6 +288,13 @@ int runMujoco(const MujocoOptions& o) {
     if (!(*duration > 0.0) || !std::isfinite(*duration) || *duration > 1e6)
       throw Error(ErrorCode::kParseError, o.model + ": numeric clod_duration " + std::to_string(*duration) +
                                               " is not a positive number of seconds");
+  }
+  if (const int id = mj_name2id(m, mjOBJ_NUMERIC, "clod_sphere_tree_depth"); id >= 0 && m->numeric_size[id] >= 1) {
+    const double depth = m->numeric_data[m->numeric_adr[id]];
+    if (!(depth >= 1.0 && depth <= 8.0) || depth != std::floor(depth))
+      throw Error(ErrorCode::kParseError,
+                  o.model + ": numeric clod_sphere_tree_depth " + std::to_string(depth) + " is not an integer in [1, 8]");
+    settings.sphereTree.depth = std::uint32_t(depth);
   }
   const std::uint32_t steps = std::max<std::uint32_t>(1, std::uint32_t(std::llround(*duration / m->opt.timestep)));
   mujoco::Collider collider(settings);

@@ -68,3 +68,20 @@ get_filename_component(lib_dir ${pc_dir} DIRECTORY)
 set(ENV{LD_LIBRARY_PATH} "${lib_dir}:$ENV{LD_LIBRARY_PATH}")
 step("consumer run (pkg-config)" ${WORK_DIR}/pc-consumer)
 check_consumer("pkg-config" "${step_output}")
+
+# 3. The Bullet plug-in, when this build has it: find_package(clod COMPONENTS bullet).
+file(GLOB_RECURSE bullet_targets ${prefix}/*/clodBulletTargets.cmake)
+if(bullet_targets)
+  set(bullet_consumer ${CONSUMER_DIR}/../consumer_bullet)
+  step("bullet consumer configure" ${CMAKE_COMMAND} -S ${bullet_consumer} -B ${WORK_DIR}/bullet-build
+       -G ${GENERATOR} -DCMAKE_BUILD_TYPE= -DCMAKE_CXX_COMPILER=${CXX} ${launcher}
+       -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF)
+  step("bullet consumer build" ${CMAKE_COMMAND} --build ${WORK_DIR}/bullet-build)
+  step("bullet consumer run" ${WORK_DIR}/bullet-build/clod_bullet_consumer)
+  if(NOT step_output MATCHES "cube at z 0\\.(49|50)[0-9]* on the plane, contacts [1-9]")
+    message(FATAL_ERROR "bullet consumer: unexpected output:\n${step_output}")
+  endif()
+  message(STATUS "bullet consumer: ${step_output}")
+else()
+  message(STATUS "bullet consumer: skipped (this build installs no clod_bullet)")
+endif()

@@ -5,6 +5,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <new>
@@ -19,6 +20,7 @@
 #include <BulletCollision/CollisionDispatch/btCollisionWorld.h>
 #include <BulletCollision/CollisionDispatch/btManifoldResult.h>
 #include <BulletCollision/CollisionShapes/btBoxShape.h>
+#include <BulletCollision/CollisionShapes/btStaticPlaneShape.h>
 #include <BulletCollision/CollisionShapes/btTriangleCallback.h>
 #include <BulletDynamics/Dynamics/btRigidBody.h>
 #include <LinearMath/btAabbUtil2.h>
@@ -162,6 +164,15 @@ struct Collider::Core {
                                                    const btCollisionObjectWrapper* w1) override;
   };
   CreateFunc createFunc;
+  struct PlaneCreateFunc : btCollisionAlgorithmCreateFunc {
+    Core* core = nullptr;
+    btCollisionAlgorithm* CreateCollisionAlgorithm(btCollisionAlgorithmConstructionInfo& ci,
+                                                   const btCollisionObjectWrapper* w0,
+                                                   const btCollisionObjectWrapper* w1) override;
+  };
+  PlaneCreateFunc planeCreateFunc;
+  std::vector<Contact> planeContacts;  // the plane algorithm's scratch (one thread: the dispatcher's)
+  std::vector<double> planeScratch;
   // The batch's pairs, reused (no allocation once grown).
   struct Entry {
     btBroadphasePair* pair;
@@ -353,6 +364,124 @@ void PairAlgorithm::processCollision(const btCollisionObjectWrapper* w0, const b
   st.priority = approach + std::max(0.0, deepest) / dt;
 }
 
+// ---- MeshShape against btStaticPlaneShape (collider.h, ColliderSettings::collidePlanes) ----
+
+// Its manifold is always (mesh, plane), whatever order the dispatcher passes: the normal Bullet
+// wants is then the plane's ("on B"), and btManifoldResult swaps the points when the pair came
+// the other way round.
+class PlaneAlgorithm : public btActivatingCollisionAlgorithm {
+public:
+  PlaneAlgorithm(const btCollisionAlgorithmConstructionInfo& ci, const btCollisionObjectWrapper* w0,
+                 const btCollisionObjectWrapper* w1, Collider::Core* core)
+      : btActivatingCollisionAlgorithm(ci, w0, w1), core_(core) {}
+  ~PlaneAlgorithm() override {
+    if (manifold_) m_dispatcher->releaseManifold(manifold_);
+  }
+  void processCollision(const btCollisionObjectWrapper* w0, const btCollisionObjectWrapper* w1,
+                        const btDispatcherInfo& info, btManifoldResult* resultOut) override;
+  btScalar calculateTimeOfImpact(btCollisionObject*, btCollisionObject*, const btDispatcherInfo&,
+                                 btManifoldResult*) override {
+    return btScalar(1);
+  }
+  void getAllContactManifolds(btManifoldArray& manifoldArray) override {
+    if (manifold_) manifoldArray.push_back(manifold_);
+  }
+
+private:
+  Collider::Core* core_;  // outlives the algorithm: uninstall drops every PlaneAlgorithm first
+  btPersistentManifold* manifold_ = nullptr;
+  std::array<std::uint32_t, 16> used_{};  // vertices of the last answer (maxContacts is capped at 16 here)
+  std::uint32_t usedCount_ = 0;
+};
+
+btCollisionAlgorithm* Collider::Core::PlaneCreateFunc::CreateCollisionAlgorithm(btCollisionAlgorithmConstructionInfo& ci,
+                                                                                const btCollisionObjectWrapper* w0,
+                                                                                const btCollisionObjectWrapper* w1) {
+  const bool m0 = MeshShape::isMeshShape(w0->getCollisionShape()), m1 = MeshShape::isMeshShape(w1->getCollisionShape());
+  if (m0 != m1) {
+    void* mem = ci.m_dispatcher1->allocateCollisionAlgorithm(int(sizeof(PlaneAlgorithm)));
+    return new (mem) PlaneAlgorithm(ci, w0, w1, core);
+  }
+  btCollisionConfiguration* config = core->dispatcher->getCollisionConfiguration();
+  return config->getCollisionAlgorithmCreateFunc(w0->getCollisionShape()->getShapeType(),
+                                                 w1->getCollisionShape()->getShapeType())
+      ->CreateCollisionAlgorithm(ci, w0, w1);
+}
+
+void PlaneAlgorithm::processCollision(const btCollisionObjectWrapper* w0, const btCollisionObjectWrapper* w1,
+                                      const btDispatcherInfo&, btManifoldResult* resultOut) {
+  const bool meshFirst = MeshShape::isMeshShape(w0->getCollisionShape());
+  const btCollisionObjectWrapper* meshW = meshFirst ? w0 : w1;
+  const btCollisionObjectWrapper* planeW = meshFirst ? w1 : w0;
+  if (!manifold_) manifold_ = m_dispatcher->getNewManifold(meshW->getCollisionObject(), planeW->getCollisionObject());
+  resultOut->setPersistentManifold(manifold_);
+  const auto* mesh = static_cast<const MeshShape*>(meshW->getCollisionShape());
+  const auto* plane = static_cast<const btStaticPlaneShape*>(planeW->getCollisionShape());
+  // The plane n . x = d in the world (its local normal and constant, turned and moved).
+  const Pose planePose = toPose(planeW->getWorldTransform());
+  const Vec3 n = (planePose.rotation * toClod(plane->getPlaneNormal())).normalized();
+  const double d = double(plane->getPlaneConstant()) + n.dot(planePose.translation);
+  const Pose meshPose = Collider::Core::meshPose(mesh, meshW->getWorldTransform());
+  const TriangleMesh& vertices = mesh->body().mesh();
+  const double threshold = double(manifold_->getContactBreakingThreshold());
+  const Aabb box = vertices.bounds();
+  const double reach = 0.5 * (box.max - box.min).norm();
+  std::vector<Contact>& contacts = core_->planeContacts;
+  contacts.clear();
+  // Selection depths are rounded down to steps of 1e-4 x the mesh's diagonal and the vertices
+  // used last substep go first, so that a flat ring of vertices at one height (a torus lying on
+  // the plane) keeps its contacts from substep to substep: reduceManifold breaks ties by input
+  // order, and points that jump around the ring make Bullet's warm-started friction impulses act
+  // at the wrong places (measured: a torus spun up to 3 rad/s in 2 s). Contact::level carries
+  // the vertex index through the reduction; the true depth goes to Bullet.
+  // Candidates lie within a band of 0.5 % of the diagonal above the lowest vertex (and below the
+  // threshold): reduceManifold spreads its picks after the deepest one whatever their depth, and
+  // points well above the plane (a torus's next ring of vertices) would stand in for the ones
+  // it rests on.
+  const double step = 1e-4 * mesh->body().diagonal();
+  double lowest = std::numeric_limits<double>::infinity();
+  const bool near = n.dot(meshPose.apply(0.5 * (box.min + box.max))) - d <= reach + threshold;
+  if (near)
+    for (const Vec3& v : vertices.vertices) lowest = std::min(lowest, n.dot(meshPose.apply(v)) - d);
+  const double cutoff = std::min(threshold, lowest + 5e-3 * mesh->body().diagonal());
+  auto candidate = [&](std::uint32_t v) {
+    const Vec3 p = meshPose.apply(vertices.vertices[v]);
+    const double distance = n.dot(p) - d;
+    if (distance >= cutoff) return;
+    Contact c;
+    c.point = p - 0.5 * distance * n;  // midway between the vertex and the plane
+    c.normal = n;                       // from the plane (B) toward the mesh (A)
+    c.depth = std::floor(-distance / step) * step;
+    c.level = v;
+    contacts.push_back(c);
+  };
+  if (near) {
+    for (std::uint32_t i = 0; i < usedCount_; ++i) candidate(used_[i]);
+    for (std::uint32_t v = 0; v < vertices.vertexCount(); ++v)
+      if (std::find(used_.begin(), used_.begin() + usedCount_, v) == used_.begin() + usedCount_) candidate(v);
+  }
+  ManifoldSettings ms;
+  ms.maxContacts = std::min<std::uint32_t>(core_->settings.maxContacts, std::uint32_t(used_.size()));
+  ms.mergeDistanceAbs = 1e-3 * mesh->body().diagonal();
+  const std::size_t kept = contacts.empty() ? 0 : reduceManifold(contacts, ms, core_->planeScratch);
+  usedCount_ = std::uint32_t(kept);
+  std::array<btVector3, 16> added;
+  for (std::size_t i = 0; i < kept; ++i) {
+    const std::uint32_t v = contacts[i].level;
+    used_[i] = v;
+    const Vec3 p = meshPose.apply(vertices.vertices[v]);
+    const double distance = n.dot(p) - d;
+    added[i] = toBt(p - distance * n);  // on the plane
+    resultOut->addContactPoint(toBt(n), added[i], btScalar(distance));
+  }
+  // This answer is complete: drop the cached points it did not give again.
+  for (int k = manifold_->getNumContacts() - 1; k >= 0; --k) {
+    const btVector3& onB = manifold_->getContactPoint(k).m_positionWorldOnB;
+    if (std::find(added.begin(), added.begin() + kept, onB) == added.begin() + kept) manifold_->removeContactPoint(k);
+  }
+  if (manifold_->getNumContacts() > 0) resultOut->refreshContactPoints();
+}
+
 // ---- the budgeted dispatch ----
 
 namespace {
@@ -467,6 +596,7 @@ Collider::Collider(const ColliderSettings& settings) : core_(std::make_shared<Co
   checkSettings(settings);
   core_->settings = settings;
   core_->createFunc.core = core_.get();
+  core_->planeCreateFunc.core = core_.get();
   core_->self = core_;
 }
 
@@ -478,9 +608,10 @@ const DispatchReport& Collider::lastDispatch() const noexcept { return core_->re
 
 void Collider::setSettings(const ColliderSettings& settings) {
   checkSettings(settings);
-  if (core_->world && settings.collideBoxes != core_->settings.collideBoxes)
-    throw Error(ErrorCode::kInvalidArgument,
-                "clod::bullet::Collider::setSettings: collideBoxes changes what install registered; uninstall first");
+  if (core_->world && (settings.collideBoxes != core_->settings.collideBoxes ||
+                       settings.collidePlanes != core_->settings.collidePlanes))
+    throw Error(ErrorCode::kInvalidArgument, "clod::bullet::Collider::setSettings: collideBoxes / collidePlanes change what "
+                                             "install registered; uninstall first");
   if (settings.model != core_->settings.model) {
     ++core_->modelEpoch;
     if (settings.model == ContactModel::kContactTree) core_->boxBodies.clear();  // rebaked with contact trees
@@ -500,7 +631,14 @@ void cleanPairs(btCollisionWorld& world, btDispatcher* d, Pred which) {
     if (pairs[i].m_algorithm && which(pairs[i])) cache->cleanOverlappingPair(pairs[i], d);
 }
 
-constexpr int kBoxType = BOX_SHAPE_PROXYTYPE, kMeshType = CUSTOM_CONCAVE_SHAPE_TYPE;
+constexpr int kBoxType = BOX_SHAPE_PROXYTYPE, kMeshType = CUSTOM_CONCAVE_SHAPE_TYPE, kPlaneType = STATIC_PLANE_PROXYTYPE;
+
+bool isMeshAndPlane(const btBroadphasePair& p) {
+  const btCollisionShape* s0 = static_cast<const btCollisionObject*>(p.m_pProxy0->m_clientObject)->getCollisionShape();
+  const btCollisionShape* s1 = static_cast<const btCollisionObject*>(p.m_pProxy1->m_clientObject)->getCollisionShape();
+  return (MeshShape::isMeshShape(s0) && s1->getShapeType() == kPlaneType) ||
+         (MeshShape::isMeshShape(s1) && s0->getShapeType() == kPlaneType);
+}
 
 }  // namespace
 
@@ -527,9 +665,14 @@ void Collider::install(btCollisionWorld& world) {
     d->registerCollisionCreateFunc(kMeshType, kBoxType, &core_->createFunc);
     d->registerCollisionCreateFunc(kBoxType, kMeshType, &core_->createFunc);
   }
+  if (core_->settings.collidePlanes) {
+    d->registerCollisionCreateFunc(kMeshType, kPlaneType, &core_->planeCreateFunc);
+    d->registerCollisionCreateFunc(kPlaneType, kMeshType, &core_->planeCreateFunc);
+  }
   d->setNearCallback(&nearCallback);
   Core& core = *core_;
   cleanPairs(world, d, [&](const btBroadphasePair& p) {
+    if (core.settings.collidePlanes && isMeshAndPlane(p)) return true;
     return core.handles(static_cast<const btCollisionObject*>(p.m_pProxy0->m_clientObject)->getCollisionShape(),
                         static_cast<const btCollisionObject*>(p.m_pProxy1->m_clientObject)->getCollisionShape());
   });
@@ -540,10 +683,13 @@ void Collider::uninstall() {
   if (!core.world) return;
   btCollisionDispatcher* d = core.dispatcher;
   btCollisionConfiguration* config = d->getCollisionConfiguration();
-  for (auto [t0, t1] : {std::pair{kMeshType, kMeshType}, std::pair{kMeshType, kBoxType}, std::pair{kBoxType, kMeshType}})
+  for (auto [t0, t1] : {std::pair{kMeshType, kMeshType}, std::pair{kMeshType, kBoxType}, std::pair{kBoxType, kMeshType},
+                        std::pair{kMeshType, kPlaneType}, std::pair{kPlaneType, kMeshType}})
     d->registerCollisionCreateFunc(t0, t1, config->getCollisionAlgorithmCreateFunc(t0, t1));
   d->setNearCallback(core.previousNearCallback);
-  cleanPairs(*core.world, d, [](const btBroadphasePair& p) { return dynamic_cast<PairAlgorithm*>(p.m_algorithm) != nullptr; });
+  cleanPairs(*core.world, d, [](const btBroadphasePair& p) {
+    return dynamic_cast<PairAlgorithm*>(p.m_algorithm) != nullptr || dynamic_cast<PlaneAlgorithm*>(p.m_algorithm) != nullptr;
+  });
   {
     std::lock_guard<std::mutex> lock(gRegistryMutex);
     std::erase_if(gRegistry, [&](const auto& e) { return e.second == &core; });

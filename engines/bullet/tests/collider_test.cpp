@@ -1,6 +1,7 @@
 // clod_bullet: Bullet's conventions against analytic box-box contacts and Bullet's own box-box
 // algorithm (the peer), a stack of clod-shaped boxes standing in Bullet's world, the per-substep
-// budget, and a non-convex container where the convex hull gives the wrong answer.
+// budget, a non-convex container where the convex hull gives the wrong answer, and baked meshes
+// against btStaticPlaneShape (contacts at the depth, a torus resting at its minor radius).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,6 +18,7 @@
 #include "clod/bake.h"
 #include "clod/bullet/collider.h"
 #include "clod/error.h"
+#include "clod/part_meshes.h"
 #include "clod/primitives.h"
 
 namespace {
@@ -433,3 +435,103 @@ TEST(BulletMeshShape, PrincipalFrameMovesAnOffCentreMeshToItsCentreOfMass) {
 }
 
 }  // namespace
+
+// ---- MeshShape against btStaticPlaneShape (ColliderSettings::collidePlanes) ----
+
+namespace plane_tests {
+
+btTransform toBtTransform(const clod::Pose& p) {
+  const clod::Quat& q = p.rotation;
+  return btTransform(btQuaternion(btScalar(q.x()), btScalar(q.y()), btScalar(q.z()), btScalar(q.w())),
+                     btVector3(btScalar(p.translation.x()), btScalar(p.translation.y()), btScalar(p.translation.z())));
+}
+
+// A 1 m cube MeshShape 1 cm into the plane z = 0: its four bottom corners are the contacts, at
+// distance -1 cm with the plane's normal (on B = the plane), whichever order the two objects
+// are in and however the plane is stated (normal and constant, or moved by its transform).
+TEST(BulletPlane, CubeIntoThePlaneGivesItsFourBottomCornersAtTheDepth) {
+  MeshShape cube(boxBody(Vec3::Constant(0.5)));
+  const double depth = 0.01;
+  struct Case {
+    btVector3 normal;
+    btScalar constant;
+    btTransform planePose;
+    bool planeFirst;
+  };
+  const Case cases[] = {
+      {btVector3(0, 0, 1), 0, pose(btVector3(0, 0, 0)), false},
+      {btVector3(0, 0, 1), 0, pose(btVector3(0, 0, 0)), true},
+      {btVector3(0, 0, 1), btScalar(-0.25), pose(btVector3(0, 0, 0.25f)), false},   // constant and transform cancel
+      {btVector3(1, 0, 0), 0, pose(btVector3(0, 0, 0), btQuaternion(btVector3(0, 1, 0), btScalar(-M_PI / 2))), true}};
+  for (const Case& k : cases) {
+    btStaticPlaneShape plane(k.normal, k.constant);
+    const btTransform cubePose = pose(btVector3(0.2f, -0.1f, btScalar(0.5 - depth)));
+    PairWorld w = k.planeFirst ? PairWorld(&plane, k.planePose, &cube, cubePose) : PairWorld(&cube, cubePose, &plane, k.planePose);
+    Collider collider;
+    collider.install(w.world);
+    // The contacts as seen from the cube (normal from the plane toward it).
+    auto contacts = w.contacts();
+    ASSERT_EQ(contacts.size(), 4u);
+    for (auto& c : contacts) {
+      const double sign = k.planeFirst ? -1.0 : 1.0;  // PairWorld reports the normal toward its `a`
+      EXPECT_NEAR(sign * c.normalBToA.z(), 1.0, kTol);
+      EXPECT_NEAR(c.depth, depth, kTol);
+    }
+    collider.uninstall();
+  }
+}
+
+// A non-convex baked mesh (a torus, genus 1: Bullet's own algorithms have nothing for a concave
+// shape on a plane) dropped flat onto a static plane rests on it: its centre at the minor radius
+// above the plane (the polygon's lowest vertex is exactly there), level, at rest; on a plane
+// tilted by 10 degrees with friction 1 (> tan 10 deg, so it sticks) likewise along the normal.
+TEST(BulletPlane, TorusRestsOnAStaticPlaneAtItsMinorRadius) {
+  const double major = 0.1, minor = 0.02;
+  const auto torus = bakeBody(clod::makeTorus(major, minor, 32, 12));
+  for (const double tilt : {0.0, 10.0}) {
+    SCOPED_TRACE(tilt);
+    const double a = tilt * M_PI / 180.0;
+    const btVector3 normal(0, btScalar(-std::sin(a)), btScalar(std::cos(a)));
+    btDefaultCollisionConfiguration config;
+    btCollisionDispatcher dispatcher(&config);
+    btDbvtBroadphase broadphase;
+    btSequentialImpulseConstraintSolver solver;
+    btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &config);
+    world.setGravity(btVector3(0, 0, -9.81f));
+    btStaticPlaneShape planeShape(normal, 0);
+    btRigidBody ground(btRigidBody::btRigidBodyConstructionInfo(0, nullptr, &planeShape));
+    ground.setFriction(1);
+    world.addRigidBody(&ground);
+    const clod::Pose frame = MeshShape::principalFrame(torus->mesh());
+    MeshShape shape(torus, frame);
+    const btScalar mass = 1;
+    btVector3 inertia;
+    shape.calculateLocalInertia(mass, inertia);
+    // The torus's plane parallel to the ground, its centre 5 mm higher than resting.
+    const btQuaternion level(btVector3(1, 0, 0), btScalar(a));
+    // The mesh placed by `start`: the body's frame is the shape's (the principal frame).
+    const btTransform shapeFromMesh = toBtTransform(frame);
+    const btTransform start(level, normal * btScalar(minor + 0.005));
+    btDefaultMotionState motion(start * shapeFromMesh.inverse());
+    btRigidBody body(btRigidBody::btRigidBodyConstructionInfo(mass, &motion, &shape, inertia));
+    body.setFriction(1);
+    world.addRigidBody(&body);
+    Collider collider;
+    collider.install(world);
+    for (int i = 0; i < 120; ++i) world.stepSimulation(btScalar(1.0 / 60), 4, btScalar(1.0 / 240));
+    // The mesh's centre (its origin) in the world: the body's frame is the principal frame.
+    const btTransform meshPose = body.getWorldTransform() * shapeFromMesh;
+    const btVector3 centre = meshPose.getOrigin();
+    const btVector3 axis = meshPose.getBasis().getColumn(2);
+    // 1 mm = 1 % of the torus's size: Bullet's penetration slop and float rounding are ~1e-4 m.
+    EXPECT_NEAR(double(centre.dot(normal)), minor, 1e-3);
+    EXPECT_GT(double(axis.dot(normal)), std::cos(1.0 * M_PI / 180));  // level within 1 degree
+    EXPECT_LT(double(body.getLinearVelocity().length()), 0.01);
+    EXPECT_LT(double((centre - normal * centre.dot(normal)).length()), 0.01);  // did not slide
+    collider.uninstall();
+    world.removeRigidBody(&body);
+    world.removeRigidBody(&ground);
+  }
+}
+
+}  // namespace plane_tests

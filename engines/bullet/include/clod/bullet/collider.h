@@ -135,6 +135,14 @@ struct ColliderSettings {
   /// as a 12-triangle mesh, on first contact: it allocates then). false: Bullet's
   /// convex-vs-concave algorithm against the MeshShape's triangles.
   bool collideBoxes = true;
+  /// Also collide MeshShape with btStaticPlaneShape (Bullet has no algorithm for a concave shape
+  /// against a plane): every mesh vertex closer to the plane than the manifold's contact
+  /// breaking threshold (or below it) is a contact, normal = the plane's normal (on B = the
+  /// plane), distance = the vertex's signed distance (exact: a mesh touches a plane at vertices
+  /// first), reduced to maxContacts by reduceManifold (deepest first, spread in the plane;
+  /// contacts within 1e-3 x the mesh's diagonal merged). Not budgeted (no tests: O(vertices) per
+  /// substep, skipped when the mesh's bounding sphere is farther than the threshold).
+  bool collidePlanes = true;
 };
 
 /// What the collider did in the last dispatch (substep).
@@ -161,7 +169,8 @@ public:
 
   /// Registers clod's algorithm on the world's dispatcher for (MeshShape, MeshShape) and, with
   /// collideBoxes, (MeshShape, btBoxShape) both ways (btCollisionDispatcher::
-  /// registerCollisionCreateFunc), and its near callback for the budget; pairs that already had an
+  /// registerCollisionCreateFunc), with collidePlanes (MeshShape, btStaticPlaneShape) both ways
+  /// (not budgeted), and its near callback for the budget; pairs that already had an
   /// algorithm between such shapes get clod's from the next dispatch on. Throws
   /// clod::Error(kInvalidArgument) when the world's dispatcher is not a btCollisionDispatcher,
   /// when this Collider or another one is already installed on it, or when the configuration's
@@ -175,7 +184,7 @@ public:
 
   const ColliderSettings& settings() const noexcept;
   /// Changes the settings between steps (a model change clears every pair's coherence cache).
-  /// Same checks as the constructor; changing collideBoxes while installed throws
+  /// Same checks as the constructor; changing collideBoxes or collidePlanes while installed throws
   /// clod::Error(kInvalidArgument) (uninstall, change, install).
   void setSettings(const ColliderSettings& settings);
 
