@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The README's test command: install missing packages, build (Release), run the whole test suite
-# and the web viewer's browser test.
+# The README's test command: install missing packages, build (Release), run the whole test suite,
+# the web viewer's browser test and every fuzz target for a bounded time (docs/testing.md).
 # With --sanitize, a second build under AddressSanitizer + UndefinedBehaviorSanitizer runs it too.
 set -euo pipefail
 cd "$(dirname "$0")/.."
