@@ -86,8 +86,9 @@ struct CollisionFilter {
 struct ContactPairEvent {
   BodyId a = 0, b = 0;                ///< a < b; the contacts' normals point from b toward a
   /// The contacts the solver is about to use (world frame, contact.h): the narrow phase's answer of
-  /// this substep, or the pair's kept manifold when the budget skipped it or manifold reuse
-  /// spared it the query (PairReport::skipped / reused).
+  /// this substep as the persistent manifold kept it (docs/dynamics.md: a finer earlier manifold
+  /// may stand, earlier points may be carried), or the pair's manifold when the budget skipped it
+  /// or manifold reuse spared it the query (PairReport::skipped / reused).
   std::span<const Contact> contacts;
   std::uint32_t substep = 0;          ///< 0-based substep of the current World::step
 };

@@ -440,7 +440,6 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
   // substep makes resting contact jitter (a stack then walks sideways).
   solveOrder.assign(order.begin(), order.end());
   std::sort(solveOrder.begin(), solveOrder.end(), [](const auto& l, const auto& r) { return l.second < r.second; });
-  if (contactCallback) runContactCallback();
 
   // Prepare constraints. Everything that depends on the velocities is read before any
   // warm-start impulse is applied, so it does not depend on the pair order.
@@ -549,6 +548,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     report.solverContacts += p->contacts.size();
   }
   report.prepareSeconds += since(tPrepare);
+  if (contactCallback) runContactCallback();
   solve(h);
   const auto tIntegrate = Clock::now();
   integrate(h);
@@ -1078,7 +1078,8 @@ std::uint64_t World::stateHash() const {
 
 // ---- World editing and queries (world.h). Kept apart from the step above: they only set state
 // that the step reads at three points (filterCandidates after each broad phase,
-// applyExternalForces after gravity, runContactCallback before the solver). ---------------------
+// applyExternalForces after gravity, runContactCallback between constraint preparation and the
+// solver). -------------------------------------------------------------------------------------
 
 namespace {
 Body& editableBody(std::vector<Body>& bodies, BodyId id, const char* call) {
