@@ -334,8 +334,12 @@ public:
   /// contact model and budget; their collision filter does not matter. The descent stops once the
   /// distance is known to exceed maxDistance (>= 0, or infinity; kInvalidArgument otherwise).
   /// The first query on a shape builds a box hierarchy over its triangles (O(T log T), kept while
-  /// a body uses the shape); a query then costs O(log Ta + log Tb) typical, O(Ta Tb) worst case
-  /// (two parallel faces at their closest distance). Not thread-safe with step() or itself.
+  /// a body uses the shape). A query's cost grows with the number of triangle pairs about as near
+  /// as the closest one: small for bodies near contact, large for curved bodies apart by their own
+  /// size (O(Ta Tb) at worst). Measured on two bunny-1500 at 200 random poses 0.4-1.2 diagonals
+  /// apart (a loaded 2-core machine): median 1 ms, 90th percentile 20 ms, slowest 41 ms; give
+  /// maxDistance (a contact margin) to stop the far ones early. Not thread-safe with step() or
+  /// itself.
   Separation separation(BodyId a, BodyId b,
                         double maxDistance = std::numeric_limits<double>::infinity()) const;
 

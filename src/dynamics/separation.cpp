@@ -80,11 +80,23 @@ bool isLeafRef(const TriangleBvh& t, std::uint32_t ref) { return ref != kRoot &&
 // Distance between box a (A's frame) and box b (B's frame) placed in A's frame by xf, a lower
 // bound of the distance between anything inside them: b is enclosed in the axis-aligned box of
 // its turned self.
+// The bounding spheres of the two boxes give a second lower bound, tighter where b is turned
+// (its axis-aligned box then grows by up to sqrt(3)); the larger of the two is used.
 double boxLowerBound(const Aabb& a, const Aabb& b, const Pose& xfAFromB, const Mat3& absRotation) {
   const Vec3 cb = xfAFromB.apply(b.center());
   const Vec3 hb = absRotation * (0.5 * b.extent());
   const Vec3 gap = ((a.center() - cb).cwiseAbs() - 0.5 * a.extent() - hb).cwiseMax(0.0);
-  return gap.norm();
+  const double spheres = (a.center() - cb).norm() - 0.5 * (a.diagonal() + b.diagonal());
+  return std::max(gap.norm(), spheres);
+}
+
+// A lower bound of the distance between two triangles: their bounding spheres (centroid, farthest
+// corner), which rejects most pairs of a leaf pair before the full triangle distance.
+double triangleLowerBound(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0, const Vec3& b1, const Vec3& b2) {
+  const Vec3 ca = (a0 + a1 + a2) / 3.0, cb = (b0 + b1 + b2) / 3.0;
+  const double ra = std::sqrt(std::max({(a0 - ca).squaredNorm(), (a1 - ca).squaredNorm(), (a2 - ca).squaredNorm()}));
+  const double rb = std::sqrt(std::max({(b0 - cb).squaredNorm(), (b1 - cb).squaredNorm(), (b2 - cb).squaredNorm()}));
+  return (ca - cb).norm() - ra - rb;
 }
 
 }  // namespace
@@ -185,9 +197,10 @@ Separation separationBetween(const std::shared_ptr<const CollisionBody>& shapeA,
         for (std::uint32_t j = nb.child[item.b & 3]; j < nb.child[item.b & 3] + nb.count[item.b & 3]; ++j) {
           const std::uint32_t triB = tb.order()[j];
           const auto& fb = mb.triangles[triB];
-          const TriangleDistance d =
-              triangleDistance(ma.vertices[fa[0]], ma.vertices[fa[1]], ma.vertices[fa[2]], xf.apply(mb.vertices[fb[0]]),
-                               xf.apply(mb.vertices[fb[1]]), xf.apply(mb.vertices[fb[2]]));
+          const Vec3 b0 = xf.apply(mb.vertices[fb[0]]), b1 = xf.apply(mb.vertices[fb[1]]), b2 = xf.apply(mb.vertices[fb[2]]);
+          const double bound = triangleLowerBound(ma.vertices[fa[0]], ma.vertices[fa[1]], ma.vertices[fa[2]], b0, b1, b2);
+          if (bound > 0.0 && bound * bound >= best2) continue;
+          const TriangleDistance d = triangleDistance(ma.vertices[fa[0]], ma.vertices[fa[1]], ma.vertices[fa[2]], b0, b1, b2);
           if (d.distanceSquared < best2) {
             best2 = d.distanceSquared;
             bestPair = d;
