@@ -28,11 +28,13 @@ for corpus in fuzz/corpus/*/; do
   target=$(basename "$corpus")
   findings="build-fuzz/findings/$target"
   work="build-fuzz/corpus/$target"  # new inputs go here, never into the repository's seeds
-  mkdir -p "$findings" "$work"
+  rm -rf "$findings" && mkdir -p "$findings" "$work"
   echo "fuzz.sh: $target for ${seconds}s"
   # -timeout: one input taking over 10 s is a hang; -rss_limit_mb: a reader that allocates without
   # bound is a bug too (the loaders check resource limits before they allocate).
-  if ! ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  # Leaks count too, except those inside Debian's libraries (fuzz/lsan.supp says which and why).
+  if ! ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=fuzz/lsan.supp:print_suppressions=0 \
+      UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
       "build-fuzz/bin/$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
       -artifact_prefix="$findings/" -print_final_stats=1 "$work" "$corpus" >"$findings/log.txt" 2>&1; then
     failed+=("$target")
