@@ -10,7 +10,7 @@
 #include "clod/mesh_io.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const char* const kHints[] = {"obj", "stl", "ply", "off", "gltf", "glb"};
+  static const char* const kHints[] = {"obj", "stl", "ply", "off", "gltf", "glb", "dae"};
   if (size < 1) return 0;
   const char* hint = kHints[data[0] % (sizeof kHints / sizeof kHints[0])];
   const std::span<const std::byte> bytes(reinterpret_cast<const std::byte*>(data + 1), size - 1);

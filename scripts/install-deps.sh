@@ -2,7 +2,7 @@
 # Installs the Debian packages clod needs (only the missing ones). Run as root.
 #   scripts/install-deps.sh            build + test dependencies
 #   scripts/install-deps.sh --peers    also the comparison peers used by bench/ (CGAL, Embree, FCL, OpenVDB; Bullet is a build dependency)
-#   scripts/install-deps.sh --fuzz     also clang and its libFuzzer runtime
+#   scripts/install-deps.sh --fuzz     also clang 16 and its libFuzzer runtime (scripts/fuzz.sh)
 set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config ccache
   libeigen3-dev libassimp-dev libtbb-dev nlohmann-json3-dev libcli11-dev libqhull-dev libxxhash-dev
@@ -15,7 +15,7 @@ packages=(build-essential cmake ninja-build pkg-config ccache
 for arg in "$@"; do
   case "$arg" in
     --peers) packages+=(libcgal-dev libembree-dev libfcl-dev libopenvdb-dev) ;;
-    --fuzz) packages+=(clang libclang-rt-14-dev) ;;
+    --fuzz) packages+=(clang-16 libclang-rt-16-dev) ;;  # clang 16: C++20 lambda captures of structured bindings (14 lacks them)
     *) echo "install-deps.sh: unknown option $arg" >&2; exit 2 ;;
   esac
 done

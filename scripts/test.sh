@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The README's test command: install missing packages, build (Release), run the whole test suite
-# and the web viewer's browser test.
+# The README's test command: install missing packages, build (Release), run the whole test suite,
+# the web viewer's browser test and every fuzz target for a bounded time (docs/testing.md).
 # With --sanitize, a second build under AddressSanitizer + UndefinedBehaviorSanitizer runs it too.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -28,6 +28,13 @@ rm -rf build/venv
 CLOD_CMAKE_BUILD_DIR="$PWD/build" build/venv/bin/pip install -q --no-build-isolation .
 (cd / && "$OLDPWD/build/venv/bin/python" -c 'import clod; print("python: import clod", clod.__version__, "from", clod.__file__)')
 scripts/test-viewer.sh build/bin/clod  # the web viewer in headless Chromium (docs/viewer.md)
+# Fuzzing (fuzz/, docs/testing.md): each reader of user files under libFuzzer + ASan + UBSan for
+# CLOD_FUZZ_SECONDS (default 10) from its seed corpus, built with clang 16 in build-fuzz/ (ccache);
+# a crash, sanitizer report, hang or runaway allocation fails the script. CLOD_FUZZ_SECONDS=0 skips it.
+if [[ "${CLOD_FUZZ_SECONDS:-10}" != 0 ]]; then
+  scripts/install-deps.sh --fuzz
+  scripts/fuzz.sh
+fi
 if [[ "${1:-}" == "--sanitize" ]]; then
   # The library's own tests under the sanitizers; the CLI's end-to-end tests ran in Release above
   # (CLOD_BUILD_CLI, CMakeLists.txt says why), and so did the engine plug-ins' (CLOD_BUILD_ENGINES).

@@ -51,6 +51,9 @@ std::string_view contactModelName(ContactModel model) noexcept;
 /// naming the text and listing the valid names.
 ContactModel parseContactModel(std::string_view name);
 
+/// Contact::featureA / featureB when the model does not say which feature a contact came from.
+inline constexpr std::uint32_t kNoContactFeature = 0xffffffffu;
+
 /// One contact point between A and B (world frame).
 struct Contact {
   Vec3 point = Vec3::Zero();    ///< the contact point
@@ -64,6 +67,14 @@ struct Contact {
   /// Level of the pair the contact came from: for sphere-trees max(level of A's sphere, level
   /// of B's sphere), 0 = the roots; for contact trees the deeper cell's depth.
   std::uint32_t level = 0;
+  /// The features of A and B the contact came from, for matching contacts across frames (what
+  /// Box2D's contact ids and Bullet's part/index pairs are for): triangle indices of the meshes
+  /// for exact contacts, sphere indices of the sphere-trees for the sphere models, node indices
+  /// of the contact trees for the contact tree. kNoContactFeature where the narrow phase does not
+  /// report them -- at present it sets none (query.h); the reported contact points of both bodies
+  /// are StepReport::contactPoints (world.h), and World::separation names the closest triangles.
+  std::uint32_t featureA = kNoContactFeature;
+  std::uint32_t featureB = kNoContactFeature;
 };
 
 /// How reduceManifold picks contacts.

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <memory>
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -289,7 +291,7 @@ std::unique_ptr<PyWorld> worldFromScene(SceneDescription scene, const std::optio
 BodyId addBody(PyWorld& w, const PyBake& shape, std::optional<double> mass, double density, const std::string& type,
                const ArrayLike& position, const ArrayLike& orientation, const ArrayLike& velocity,
                const ArrayLike& angularVelocity, double restitution, double friction,
-               const std::string& name) {
+               const std::string& name, double scale) {
   RigidBodyDesc desc;
   desc.name = name.empty() ? "body " + std::to_string(w.world.bodyCount()) : name;
   desc.shape = shape.body;
@@ -307,6 +309,12 @@ BodyId addBody(PyWorld& w, const PyBake& shape, std::optional<double> mass, doub
   if (desc.type == BodyType::kDynamic) {
     if (!std::isfinite(density) || !(density > 0.0)) invalidArgument("density: must be finite and > 0");
     MassProperties p = computeMassPropertiesOrBoundingBox(shape.contents->mesh, density);
+    // The scaled body at the same density (World::addBody with a scale takes the scaled body's).
+    if (std::isfinite(scale) && scale > 0.0) {
+      p.mass *= scale * scale * scale;
+      p.inertia *= std::pow(scale, 5);
+      p.centerOfMass *= scale;
+    }
     if (mass) {
       const double m = *mass;
       if (!std::isfinite(m) || !(m > 0.0)) invalidArgument("mass: must be finite and > 0");
@@ -317,14 +325,83 @@ BodyId addBody(PyWorld& w, const PyBake& shape, std::optional<double> mass, doub
     desc.inertia = p.inertia;
     desc.centerOfMass = p.centerOfMass;
   }
-  return w.world.addBody(desc);
+  return w.world.addBody(desc, scale);
+}
+
+/// A body's state, or NaN everywhere for a removed id (the arrays keep one row per id).
+RigidBodyState stateOrNan(const World& world, BodyId id) {
+  if (world.contains(id)) return world.state(id);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  return RigidBodyState{Vec3::Constant(nan), Quat(nan, nan, nan, nan), Vec3::Constant(nan), Vec3::Constant(nan)};
+}
+
+Quat quatArg(py::handle obj, const char* name) {
+  DoubleArray q = toDoubleArray(obj, name);
+  if (q.size() != 4 || q.ndim() != 1) invalidArgument(std::string(name) + ": expected a quaternion (w, x, y, z), got shape " + shapeText(q));
+  requireFinite(q, name, 4);
+  return Quat(q.data()[0], q.data()[1], q.data()[2], q.data()[3]);
+}
+
+void setBodyState(PyWorld& w, BodyId id, const std::optional<ArrayLike>& position, const std::optional<ArrayLike>& orientation,
+                  const std::optional<ArrayLike>& velocity, const std::optional<ArrayLike>& angularVelocity) {
+  RigidBodyState s = w.world.state(id);
+  if (position) s.position = vec3Arg(*position, "position");
+  if (orientation) s.orientation = quatArg(*orientation, "orientation");
+  if (velocity) s.velocity = vec3Arg(*velocity, "velocity");
+  if (angularVelocity) s.angularVelocity = vec3Arg(*angularVelocity, "angular_velocity");
+  w.world.setState(id, s);
+}
+
+/// World position of a body's centre of mass (where a force without a point acts).
+Vec3 centreOfMass(const World& world, BodyId id) {
+  const RigidBodyState s = world.state(id);
+  return s.position + s.orientation * world.desc(id).centerOfMass;
+}
+
+py::dict separationDict(const Separation& r) {
+  py::dict out;
+  out["distance"] = r.distance;
+  out["within_max"] = r.withinMax;
+  out["overlapping"] = r.overlapping;
+  out["point_a"] = py::make_tuple(r.pointA.x(), r.pointA.y(), r.pointA.z());
+  out["point_b"] = py::make_tuple(r.pointB.x(), r.pointB.y(), r.pointB.z());
+  out["triangle_a"] = r.triangleA;
+  out["triangle_b"] = r.triangleB;
+  return out;
+}
+
+/// World.set_contact_callback: the Python callable gets (a, b, pos (C, 3), normal (C, 3), depth
+/// (C,), substep) and returns a truth value (False disables the pair for the step). It runs inside
+/// step(), which released the GIL: the wrapper takes it back for the call.
+void setContactCallback(PyWorld& w, const py::object& callback) {
+  if (callback.is_none()) {
+    w.world.setContactCallback({});
+    return;
+  }
+  if (!PyCallable_Check(callback.ptr())) invalidArgument("callback: expected a callable or None");
+  auto held = std::make_shared<py::object>(callback);
+  w.world.setContactCallback([held](const ContactPairEvent& e) {
+    py::gil_scoped_acquire acquire;
+    const py::ssize_t n = static_cast<py::ssize_t>(e.contacts.size());
+    py::array_t<double> pos({n, py::ssize_t(3)}), normal({n, py::ssize_t(3)}), depth(n);
+    for (py::ssize_t i = 0; i < n; ++i) {
+      const Contact& c = e.contacts[static_cast<std::size_t>(i)];
+      for (int k = 0; k < 3; ++k) {
+        pos.mutable_data()[3 * i + k] = c.point[k];
+        normal.mutable_data()[3 * i + k] = c.normal[k];
+      }
+      depth.mutable_data()[i] = c.depth;
+    }
+    // A Python exception becomes py::error_already_set and leaves step() with it.
+    return py::bool_((*held)(e.a, e.b, pos, normal, depth, e.substep)).cast<bool>();
+  });
 }
 
 template <typename Get>
 py::array_t<double> stateArray(const World& world, int width, Get get) {
   const std::size_t n = world.bodyCount();
   py::array_t<double> out({py::ssize_t(n), py::ssize_t(width)});
-  for (std::size_t i = 0; i < n; ++i) get(world.state(static_cast<BodyId>(i)), out.mutable_data() + width * i);
+  for (std::size_t i = 0; i < n; ++i) get(stateOrNan(world, static_cast<BodyId>(i)), out.mutable_data() + width * i);
   return out;
 }
 
@@ -369,7 +446,7 @@ py::dict runWorld(PyWorld& w, std::optional<long long> stepsArg, std::optional<d
       contactsOut[k] = static_cast<std::uint32_t>(report.contacts.size());
       narrowOut[k] = report.narrowPhaseSeconds;
       for (std::size_t i = 0; i < n; ++i) {
-        const RigidBodyState state = w.world.state(static_cast<BodyId>(i));
+        const RigidBodyState state = stateOrNan(w.world, static_cast<BodyId>(i));
         putPosition(state, pos + (k * n + i) * 3);
         putOrientation(state, ori + (k * n + i) * 4);
       }
@@ -676,6 +753,15 @@ void bindDynamics(py::module_& mod) {
           },
           "(C, 2) uint32: body ids (a, b) of each contact")
       .def_property_readonly(
+          "contact_points", [](const StepReport& r) {
+            py::array_t<double> out({py::ssize_t(r.contactPoints.size()), py::ssize_t(2), py::ssize_t(3)});
+            for (std::size_t i = 0; i < r.contactPoints.size(); ++i)
+              for (int j = 0; j < 2; ++j)
+                for (int k = 0; k < 3; ++k) out.mutable_data()[6 * i + 3 * j + k] = r.contactPoints[i][j][k];
+            return out;
+          },
+          "(C, 2, 3) float64: per contact the point on body a and the point on body b the solver holds apart")
+      .def_property_readonly(
           "pairs", [](const StepReport& r) {
             const py::ssize_t n = static_cast<py::ssize_t>(r.pairs.size());
             py::array_t<std::uint32_t> bodies({n, py::ssize_t(2)}), level(n), contacts(n);
@@ -747,8 +833,9 @@ void bindDynamics(py::module_& mod) {
            py::arg("type") = "dynamic", py::arg("position") = py::make_tuple(0.0, 0.0, 0.0),
            py::arg("orientation") = py::make_tuple(1.0, 0.0, 0.0, 0.0), py::arg("velocity") = py::make_tuple(0.0, 0.0, 0.0),
            py::arg("angular_velocity") = py::make_tuple(0.0, 0.0, 0.0), py::arg("restitution") = 0.0, py::arg("friction") = 0.5,
-           py::arg("name") = "",
+           py::arg("name") = "", py::arg("scale") = 1.0,
            "Adds a body with shape (a clod.Bake; shared, not copied) and returns its id (0, 1, ...).\n"
+           "scale: uniform scale of the shape (> 0), without baking again (mass properties follow at `density`).\n"
            "type: \"dynamic\", \"static\" or \"kinematic\". Mass properties are the mesh's at `density` (an open mesh:\n"
            "its bounding box's); `mass` rescales them. position: where the mesh origin goes; orientation (w, x, y, z);\n"
            "velocity of the centre of mass; angular_velocity in the world frame (rad/s).")
@@ -771,21 +858,24 @@ void bindDynamics(py::module_& mod) {
       .def_property_readonly(
           "names", [](const PyWorld& self) {
             std::vector<std::string> names;
-            for (std::size_t i = 0; i < self.world.bodyCount(); ++i) names.push_back(self.world.desc(static_cast<BodyId>(i)).name);
+            for (std::size_t i = 0; i < self.world.bodyCount(); ++i)
+              names.push_back(self.world.contains(BodyId(i)) ? self.world.desc(static_cast<BodyId>(i)).name : std::string());
             return names;
           },
           "body names, by id")
       .def_property_readonly(
           "types", [](const PyWorld& self) {
             std::vector<std::string> types;
-            for (std::size_t i = 0; i < self.world.bodyCount(); ++i) types.push_back(bodyTypeName(self.world.type(static_cast<BodyId>(i))));
+            for (std::size_t i = 0; i < self.world.bodyCount(); ++i)
+              types.push_back(self.world.contains(BodyId(i)) ? bodyTypeName(self.world.type(static_cast<BodyId>(i))) : "removed");
             return types;
           },
           "current body types (a body that left the bounds is \"static\")")
       .def_property_readonly(
           "masses", [](const PyWorld& self) {
             py::array_t<double> out(py::ssize_t(self.world.bodyCount()));
-            for (std::size_t i = 0; i < self.world.bodyCount(); ++i) out.mutable_data()[i] = self.world.mass(static_cast<BodyId>(i));
+            for (std::size_t i = 0; i < self.world.bodyCount(); ++i)
+              out.mutable_data()[i] = self.world.contains(BodyId(i)) ? self.world.mass(static_cast<BodyId>(i)) : 0.0;
             return out;
           },
           "(n,) float64 (0 for static and kinematic bodies)")
@@ -815,6 +905,60 @@ void bindDynamics(py::module_& mod) {
            "Changes the contact model between steps (the model's data must be in the bodies' bakes).")
       .def("set_budget", [](PyWorld& self, std::uint64_t tests) { self.world.setBudgetTests(tests); }, py::arg("tests"),
            "Changes the tests-per-step budget between steps (0 = unlimited).")
+      .def("remove_body", [](PyWorld& self, BodyId id) { self.world.removeBody(id); }, py::arg("id"),
+           "Removes a body. Its id is retired, never reused; every other id stays valid. The state arrays keep\n"
+           "a row per id (NaN for removed ones), types says \"removed\".")
+      .def("contains", [](const PyWorld& self, BodyId id) { return self.world.contains(id); }, py::arg("id"),
+           "True when id names a body that was added and not removed.")
+      .def("set_state", &setBodyState, py::arg("id"), py::kw_only(), py::arg("position") = py::none(),
+           py::arg("orientation") = py::none(), py::arg("velocity") = py::none(), py::arg("angular_velocity") = py::none(),
+           "Sets what is given of a body's state (the rest stays). orientation (w, x, y, z) must be a unit\n"
+           "quaternion to within 1e-3; a static body's velocities must stay zero (clod.InvalidArgumentError).")
+      .def(
+          "apply_force", [](PyWorld& self, BodyId id, const ArrayLike& force, const std::optional<ArrayLike>& point) {
+            const Vec3 f = vec3Arg(force, "force");
+            self.world.applyForce(id, f, point ? vec3Arg(*point, "point") : centreOfMass(self.world, id));
+          },
+          py::arg("id"), py::arg("force"), py::arg("point") = py::none(),
+          "Force (world frame) on a dynamic body during the next step, at `point` (world; default the centre\n"
+          "of mass). Accumulates until the step, then clears. Ignored for static and kinematic bodies.")
+      .def("apply_torque", [](PyWorld& self, BodyId id, const ArrayLike& torque) { self.world.applyTorque(id, vec3Arg(torque, "torque")); },
+           py::arg("id"), py::arg("torque"), "Torque (world frame) during the next step, like apply_force.")
+      .def(
+          "apply_impulse", [](PyWorld& self, BodyId id, const ArrayLike& impulse, const std::optional<ArrayLike>& point) {
+            const Vec3 j = vec3Arg(impulse, "impulse");
+            self.world.applyImpulse(id, j, point ? vec3Arg(*point, "point") : centreOfMass(self.world, id));
+          },
+          py::arg("id"), py::arg("impulse"), py::arg("point") = py::none(),
+          "Impulse at `point` (world; default the centre of mass), applied to the velocities at once.")
+      .def(
+          "set_filter", [](PyWorld& self, BodyId id, std::uint32_t group, std::uint32_t mask) {
+            self.world.setFilter(id, CollisionFilter{group, mask});
+          },
+          py::arg("id"), py::kw_only(), py::arg("group") = 1u, py::arg("mask") = 0xffffffffu,
+          "Collision filter: bodies a and b collide only if (a.group & b.mask) and (b.group & a.mask).")
+      .def(
+          "filter", [](const PyWorld& self, BodyId id) {
+            const CollisionFilter f = self.world.filter(id);
+            return py::make_tuple(f.group, f.mask);
+          },
+          py::arg("id"), "(group, mask) of a body")
+      .def("set_contact_callback", &setContactCallback, py::arg("callback"),
+           "callback(a, b, pos, normal, depth, substep) -> bool, called per pair with contacts in every substep\n"
+           "(pos, normal (C, 3), depth (C,)); False disables the pair for the rest of the step. None removes it.\n"
+           "It must not edit the world. Slows stepping: the GIL is taken for each call.")
+      .def(
+          "separation", [](const PyWorld& self, BodyId a, BodyId b, double maxDistance) {
+            Separation r;
+            {
+              py::gil_scoped_release release;
+              r = self.world.separation(a, b, maxDistance);
+            }
+            return separationDict(r);
+          },
+          py::arg("a"), py::arg("b"), py::kw_only(), py::arg("max_distance") = std::numeric_limits<double>::infinity(),
+          "Exact closest distance between two bodies' surfaces as placed now: a dict with distance, within_max,\n"
+          "overlapping, point_a, point_b (world), triangle_a, triangle_b (world.h Separation). GIL released.")
       .def_property_readonly("model", [](const PyWorld& self) { return std::string(contactModelName(self.world.settings().model)); },
                              "the contact model of every pair")
       .def_property_readonly("budget", [](const PyWorld& self) { return self.world.settings().budgetTests; }, "tests per step (0 = unlimited)")

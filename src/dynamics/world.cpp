@@ -15,6 +15,7 @@
 
 #include "clod/error.h"
 #include "clod/query.h"
+#include "separation.h"
 
 namespace clod {
 namespace {
@@ -62,6 +63,12 @@ struct Body {
   Vec3 vp = Vec3::Zero();
   Vec3 wp = Vec3::Zero();
   Mat3 invInertiaWorld = Mat3::Zero();
+  // World editing (world.h; the functions at the end of this file): a retired id, the force and
+  // torque for the next step, the collision filter.
+  bool removed = false;
+  Vec3 force = Vec3::Zero();
+  Vec3 torque = Vec3::Zero();
+  CollisionFilter filter;
 
   Pose pose() const { return Pose{q, x - q * comLocal}; }
   Aabb worldBox(double margin) const {
@@ -180,6 +187,28 @@ struct World::Impl {
   double kineticEnergyOfDynamicBodies() const;
   void integrate(double h);
   void checkFinite() const;
+
+  // World editing and queries (world.h: removeBody ... separation; defined at the end of this
+  // file). filtering: a body was removed or given a filter, so filterCandidates has work to do.
+  bool filtering = false;
+  bool forcesPending = false;
+  ContactCallback contactCallback;
+  std::vector<std::uint64_t> disabledPairs;  // sorted pair keys the callback disabled this step
+  std::vector<Contact> callbackContacts;
+  std::uint32_t substepIndex = 0;
+  struct ScaledShape {
+    std::shared_ptr<const CollisionBody> source;  // kept: the key's pointer cannot be reused
+    double scale = 1.0;
+    std::shared_ptr<const CollisionBody> scaled;
+  };
+  std::vector<ScaledShape> scaledShapes;
+  mutable detail::SeparationCache separationCache;
+  void filterCandidates(std::vector<BodyPair>& pairs) const;
+  void applyExternalForces(double h);
+  void runContactCallback();
+  void forgetPairsOf(BodyId id);
+  void beginStep();
+  void endStep();
 };
 
 World::World(const WorldSettings& settings) : impl_(std::make_unique<Impl>()) {
@@ -245,6 +274,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
   // Gravity first (semi-implicit Euler: the solver then sees the velocity contacts must stop).
   for (Body& b : bodies)
     if (b.type == BodyType::kDynamic) b.v += s.gravity * h;
+  applyExternalForces(h);
 
   // Broad phase: boxes grown by the distance a body moves this substep (speculative margin).
   boxes.resize(bodies.size());
@@ -256,6 +286,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     active[i] = b.type == BodyType::kDynamic;
   }
   findOverlappingPairs(boxes, active.data(), candidates, bpScratch);
+  filterCandidates(candidates);
   report.candidatePairs += candidates.size();
 
   for (auto& [key, p] : pairs) p.seen = false;
@@ -532,6 +563,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     report.solverContacts += p->contacts.size();
   }
   report.prepareSeconds += since(tPrepare);
+  if (contactCallback) runContactCallback();
   solve(h);
   const auto tIntegrate = Clock::now();
   integrate(h);
@@ -877,6 +909,7 @@ const StepReport& World::step(double dt) {
   Impl& m = *impl_;
   m.report = StepReport{};
   m.pairReports.clear();
+  m.beginStep();
   // Substeps are for bodies that can touch something during the step: one whose box, grown by
   // the distance it can move in the whole step, overlaps no other body's grown box cannot meet
   // (or tunnel through) anything before the next step, however fast it is -- e.g. a body falling
@@ -898,6 +931,7 @@ const StepReport& World::step(double dt) {
     m.boxes[i] = b.worldBox(m.stepTravel[i]);
   }
   findOverlappingPairs(m.boxes, m.active.data(), m.candidates, m.bpScratch);
+  m.filterCandidates(m.candidates);
   // Two rules, the larger wins: no body travels more than kTravelFraction of the thinnest
   // extent (no tunnelling), and two bodies that may touch this step travel together at most
   // kArrivalTravelRel of the smaller diagonal (no deep first contact; capped, see above).
@@ -966,7 +1000,11 @@ const StepReport& World::step(double dt) {
     for (const SolverContact& cp : p->contacts) {
       m.report.contacts.push_back(cp.c);
       m.report.contactBodies.push_back(ids);
+      const Body& a = m.bodies[ids[0]];
+      const Body& b = m.bodies[ids[1]];
+      m.report.contactPoints.push_back({a.x + a.q * cp.anchorA, b.x + b.q * cp.anchorB});
     }
+  m.endStep();
   return m.report;
 }
 
@@ -981,6 +1019,9 @@ const Body& bodyAt(const std::vector<Body>& bodies, BodyId id, const char* acces
                                                  " out of range (the world has " + std::to_string(bodies.size()) +
                                                  " bodies)");
   }
+  if (bodies[id].removed)
+    throw Error(ErrorCode::kInvalidArgument,
+                std::string("World::") + accessor + ": body " + std::to_string(id) + " was removed");
   return bodies[id];
 }
 }  // namespace
@@ -1051,6 +1092,205 @@ std::uint64_t World::stateHash() const {
     for (int k = 0; k < 4; ++k) mix(b.q.coeffs()[k]);
   }
   return hash;
+}
+
+// ---- World editing and queries (world.h). Kept apart from the step above: they only set state
+// that the step reads at three points (filterCandidates after each broad phase,
+// applyExternalForces after gravity, runContactCallback between constraint preparation and the
+// solver). -------------------------------------------------------------------------------------
+
+namespace {
+Body& editableBody(std::vector<Body>& bodies, BodyId id, const char* call) {
+  return const_cast<Body&>(bodyAt(bodies, id, call));
+}
+void requireFinite(const Vec3& v, BodyId id, const char* call, const char* what) {
+  if (!v.allFinite())
+    throw Error(ErrorCode::kInvalidArgument,
+                std::string("World::") + call + ": body " + std::to_string(id) + ": " + what + " must be finite");
+}
+}  // namespace
+
+BodyId World::addBody(const RigidBodyDesc& desc, double scale) {
+  if (!(scale > 0.0 && std::isfinite(scale)))
+    throw Error(ErrorCode::kInvalidArgument, "body " + std::to_string(impl_->bodies.size()) + " '" + desc.name +
+                                                 "': scale must be > 0 and finite, got " + std::to_string(scale));
+  if (!desc.shape || scale == 1.0) return addBody(desc);
+  std::shared_ptr<const CollisionBody> scaled;
+  for (const Impl::ScaledShape& s : impl_->scaledShapes)
+    if (s.source == desc.shape && s.scale == scale) scaled = s.scaled;
+  if (!scaled) {
+    scaled = scaleCollisionBody(*desc.shape, scale);
+    impl_->scaledShapes.push_back({desc.shape, scale, scaled});
+  }
+  RigidBodyDesc d = desc;
+  d.shape = std::move(scaled);
+  return addBody(d);
+}
+
+bool World::contains(BodyId id) const noexcept { return id < impl_->bodies.size() && !impl_->bodies[id].removed; }
+
+void World::Impl::forgetPairsOf(BodyId id) {
+  for (auto it = pairs.begin(); it != pairs.end();) {
+    const BodyId a = BodyId(it->first >> 32), b = BodyId(it->first & 0xffffffffu);
+    it = a == id || b == id ? pairs.erase(it) : std::next(it);
+  }
+}
+
+void World::removeBody(BodyId id) {
+  Body& b = editableBody(impl_->bodies, id, "removeBody");
+  // A static body with no extent that the broad phase's candidates are filtered against: it
+  // neither moves (integrate skips static bodies) nor counts in the momenta and energies, and an
+  // infinite extent keeps it out of the step's thinnest-body substep rule. The shape stays: a
+  // removed id keeps a small record (ids are not reused), and the step never reads it.
+  b.removed = true;
+  b.type = BodyType::kStatic;
+  b.invMass = 0.0;
+  b.invInertiaLocal.setZero();
+  b.invInertiaWorld.setZero();
+  b.v.setZero();
+  b.w.setZero();
+  b.force.setZero();
+  b.torque.setZero();
+  b.minExtent = std::numeric_limits<double>::infinity();
+  impl_->filtering = true;
+  impl_->forgetPairsOf(id);
+  bool shapeInUse = false;
+  for (const Body& other : impl_->bodies) shapeInUse = shapeInUse || (!other.removed && other.desc.shape == b.desc.shape);
+  if (!shapeInUse) impl_->separationCache.forget(b.desc.shape.get());
+}
+
+void World::setState(BodyId id, const RigidBodyState& state) {
+  Body& b = editableBody(impl_->bodies, id, "setState");
+  requireFinite(state.position, id, "setState", "position");
+  requireFinite(state.velocity, id, "setState", "velocity");
+  requireFinite(state.angularVelocity, id, "setState", "angular velocity");
+  if (!state.orientation.coeffs().allFinite())
+    throw Error(ErrorCode::kInvalidArgument, "World::setState: body " + std::to_string(id) + ": orientation must be finite");
+  const double norm = state.orientation.norm();
+  if (!(std::abs(norm - 1.0) <= 1e-3))
+    throw Error(ErrorCode::kInvalidArgument, "World::setState: body " + std::to_string(id) +
+                                                 ": orientation must be a unit quaternion (|q| = " + std::to_string(norm) + ")");
+  if (b.type == BodyType::kStatic && (!state.velocity.isZero(0.0) || !state.angularVelocity.isZero(0.0)))
+    throw Error(ErrorCode::kInvalidArgument,
+                "World::setState: body " + std::to_string(id) + " is static: its velocities must be zero");
+  b.q = state.orientation.normalized();
+  b.x = state.position + b.q * b.comLocal;
+  b.v = state.velocity;
+  b.w = state.angularVelocity;
+  b.invInertiaWorld = worldInverseInertia(b.invInertiaLocal, b.q);
+  impl_->forgetPairsOf(id);
+}
+
+void World::applyForce(BodyId id, const Vec3& force) {
+  Body& b = editableBody(impl_->bodies, id, "applyForce");
+  requireFinite(force, id, "applyForce", "force");
+  if (b.type != BodyType::kDynamic) return;
+  b.force += force;
+  impl_->forcesPending = true;
+}
+
+void World::applyForce(BodyId id, const Vec3& force, const Vec3& pointWorld) {
+  Body& b = editableBody(impl_->bodies, id, "applyForce");
+  requireFinite(force, id, "applyForce", "force");
+  requireFinite(pointWorld, id, "applyForce", "point");
+  if (b.type != BodyType::kDynamic) return;
+  b.force += force;
+  b.torque += (pointWorld - b.x).cross(force);
+  impl_->forcesPending = true;
+}
+
+void World::applyTorque(BodyId id, const Vec3& torque) {
+  Body& b = editableBody(impl_->bodies, id, "applyTorque");
+  requireFinite(torque, id, "applyTorque", "torque");
+  if (b.type != BodyType::kDynamic) return;
+  b.torque += torque;
+  impl_->forcesPending = true;
+}
+
+void World::applyImpulse(BodyId id, const Vec3& impulse, const Vec3& pointWorld) {
+  Body& b = editableBody(impl_->bodies, id, "applyImpulse");
+  requireFinite(impulse, id, "applyImpulse", "impulse");
+  requireFinite(pointWorld, id, "applyImpulse", "point");
+  if (b.type != BodyType::kDynamic) return;
+  b.v += b.invMass * impulse;
+  b.w += b.invInertiaWorld * (pointWorld - b.x).cross(impulse);
+}
+
+void World::setFilter(BodyId id, const CollisionFilter& filter) {
+  editableBody(impl_->bodies, id, "setFilter").filter = filter;
+  impl_->filtering = true;
+}
+CollisionFilter World::filter(BodyId id) const { return bodyAt(impl_->bodies, id, "filter").filter; }
+
+void World::setContactCallback(ContactCallback callback) { impl_->contactCallback = std::move(callback); }
+
+Separation World::separation(BodyId a, BodyId b, double maxDistance) const {
+  const Body& ba = bodyAt(impl_->bodies, a, "separation");
+  const Body& bb = bodyAt(impl_->bodies, b, "separation");
+  if (a == b)
+    throw Error(ErrorCode::kInvalidArgument, "World::separation: bodies a and b are both " + std::to_string(a));
+  if (!(maxDistance >= 0.0))
+    throw Error(ErrorCode::kInvalidArgument, "World::separation: maxDistance must be >= 0, got " + std::to_string(maxDistance));
+  return detail::separationBetween(ba.desc.shape, ba.pose(), bb.desc.shape, bb.pose(), maxDistance,
+                                   impl_->separationCache);
+}
+
+// Drops the candidate pairs of removed bodies, pairs their filters keep apart, and pairs the
+// contact callback disabled this step: before budget division and narrow phase, so they cost
+// nothing. A pair that leaves the candidates forgets its contacts and caches (substep).
+void World::Impl::filterCandidates(std::vector<BodyPair>& candidatePairs) const {
+  if (!filtering && disabledPairs.empty()) return;
+  std::erase_if(candidatePairs, [&](const BodyPair& c) {
+    const Body& a = bodies[c[0]];
+    const Body& b = bodies[c[1]];
+    if (a.removed || b.removed) return true;
+    if ((a.filter.group & b.filter.mask) == 0 || (b.filter.group & a.filter.mask) == 0) return true;
+    return std::binary_search(disabledPairs.begin(), disabledPairs.end(), pairKey(c[0], c[1]));
+  });
+}
+
+// Like gravity: each substep's velocities get force / m * h and I^-1 torque * h.
+void World::Impl::applyExternalForces(double h) {
+  if (!forcesPending) return;
+  for (Body& b : bodies)
+    if (b.type == BodyType::kDynamic) {
+      b.v += b.invMass * h * b.force;
+      b.w += b.invInertiaWorld * (h * b.torque);
+    }
+}
+
+// The contact callback, per pair with contacts in body-id order (the solver's order), so the
+// calls are deterministic. A pair it disables loses its contacts now and its candidacy for the
+// rest of the step (filterCandidates); its manifold, warm start and coherence cache go with it.
+void World::Impl::runContactCallback() {
+  for (auto& [p, ids] : solveOrder) {
+    if (p->contacts.empty()) continue;
+    callbackContacts.clear();
+    for (const SolverContact& cp : p->contacts) callbackContacts.push_back(cp.c);
+    const ContactPairEvent event{ids[0], ids[1], callbackContacts, substepIndex};
+    if (contactCallback(event)) continue;
+    const std::uint64_t key = pairKey(ids[0], ids[1]);
+    disabledPairs.insert(std::lower_bound(disabledPairs.begin(), disabledPairs.end(), key), key);
+    p->contacts.clear();
+    p->previous.clear();
+    p->reusable = false;
+    p->cache.clear();
+  }
+  ++substepIndex;
+}
+
+void World::Impl::beginStep() {
+  disabledPairs.clear();
+  substepIndex = 0;
+}
+
+void World::Impl::endStep() {
+  if (!forcesPending) return;
+  for (Body& b : bodies) {
+    b.force.setZero();
+    b.torque.setZero();
+  }
+  forcesPending = false;
 }
 
 }  // namespace clod

@@ -195,7 +195,9 @@ SceneDescription parseScene(std::string_view text, const std::filesystem::path& 
   try {
     DuplicateKeyCheck check(r);
     j = Json::parse(text, [&check](int, Json::parse_event_t event, Json& parsed) { return check(event, parsed); });
-  } catch (const Json::parse_error& e) {
+  } catch (const Json::exception& e) {
+    // parse_error, and out_of_range for a number beyond a double ("1E666", found by
+    // fuzz_scene_load): both are bad text, not a bug.
     throw Error(ErrorCode::kSceneError, fileName + ": not valid JSON: " + e.what());
   }
   r.object(j, "", {"gravity", "dt", "steps", "duration", "contact_model", "budget", "budget_us", "max_contacts", "min_substeps",
