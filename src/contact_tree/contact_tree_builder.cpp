@@ -55,10 +55,10 @@ struct CellResult {
 
 void checkSettings(const ContactTreeSettings& s) {
   auto bad = [](const std::string& what) { throw Error(ErrorCode::kInvalidArgument, "contact tree settings: " + what); };
-  // Stored values are integers of errorAbs / 8..16 (ContactTree::valueStep) below 2^46: with
-  // errorRel >= 1e-9 the largest distance in the root cube (< 4 diagonals) stays far below.
-  if (!(std::isfinite(s.errorRel) && s.errorRel >= 1e-9))
-    bad("errorRel " + std::to_string(s.errorRel) + " must be finite and >= 1e-9");
+  // Stored values are integers of steps >= q 2^-24 (detail::latticeStep) that the codec keeps
+  // below 2^46: with errorRel >= 1e-6 they stay below 1.2 diagonals / (2^-28 eps) < 2^39.
+  if (!(std::isfinite(s.errorRel) && s.errorRel >= 1e-6))
+    bad("errorRel " + std::to_string(s.errorRel) + " must be finite and >= 1e-6");
   if (s.maxDepth < 1 || s.maxDepth > 20) bad("maxDepth " + std::to_string(s.maxDepth) + " must be in 1..20");
   if (!(std::isfinite(s.bandRel) && s.bandRel >= 0.0))
     bad("bandRel " + std::to_string(s.bandRel) + " must be finite and >= 0");
@@ -253,7 +253,7 @@ void Builder::measureCell(const PendingCell& cell, std::uint32_t depth, double* 
   }
 
   // Measured values cannot exceed the rigorous Lipschitz bound unless the field jumps.
-  const double step = tree_.valueStep();
+  const double step = detail::latticeStep(tree_, depth);
   r.error = static_cast<float>(r.discontinuous ? kGapFactor * error : std::min(kGapFactor * error, 0.5 * (diagonal + step)));
   r.bandError = static_cast<float>(bandError);
   // Stored as the bake file stores them: prediction from the corners + a multiple of q.
@@ -291,7 +291,7 @@ void Builder::measureCell(const PendingCell& cell, std::uint32_t depth, double* 
     // plane and rounded up, so it still bounds |plane - exact| at the lattice points.
     const std::array<std::int32_t, 2> oct = detail::encodeOctNormal(n.x(), n.y(), n.z());
     r.halfSpace.normal = detail::decodeOctNormal(oct[0], oct[1]);
-    const double hsStep = tree_.halfSpaceStep();
+    const double hsStep = detail::latticeStep(tree_, depth) / 16.0;
     const double prediction = detail::offsetPrediction(cell.corners, r.split, r.lattice[13]);
     r.halfSpace.offset = detail::storedValue(prediction, detail::residualUnits(-dc, prediction, hsStep), hsStep);
     const Vec3 nr(r.halfSpace.normal[0], r.halfSpace.normal[1], r.halfSpace.normal[2]);

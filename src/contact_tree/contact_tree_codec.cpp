@@ -125,8 +125,7 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
   }
   if (tree.lattice.size() != interiorCount * kContactTreeLatticePerNode) refuse("lattice size does not match the interior nodes");
   if (tree.halfSpaces.size() != surfaceCount) refuse("halfSpaces size does not match the surface bitmap");
-  const double step = tree.valueStep(), hsStep = tree.halfSpaceStep();
-  if (!(step > 0.0)) refuse("errorAbs is not finite and > 0");
+  if (!(tree.valueStep() > 0.0)) refuse("errorAbs is not finite and > 0");
   for (float v : tree.rootCorners)
     if (!std::isfinite(v)) refuse("root corner value is not finite");
 
@@ -149,6 +148,7 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
   for (std::uint32_t d = 0; d < tree.depthCount(); ++d) {
     next.clear();
     const int dc = depthContext(d);
+    const double step = detail::latticeStep(tree, d), hsStep = step / 16.0;
     for (std::uint32_t j = 0; j < level.size(); ++j) {
       const std::uint32_t node = tree.levelOffsets[d] + j;
       LevelCell cell = level[j];
@@ -248,7 +248,6 @@ ContactTree decodeContactTree(ByteReader& in) {
   // larger count is refused before anything of that size is allocated.
   if (n < 1 || n > 0xfffffff0u || n > 320.0 * double(coded.size()) + 64.0)
     fail("node count " + std::to_string(n) + " is impossible for a coded stream of " + std::to_string(coded.size()) + " bytes");
-  const double step = tree.valueStep(), hsStep = tree.halfSpaceStep();
   for (int c = 0; c < 8; ++c)
     if (!std::isfinite(tree.rootCorners[c])) fail("rootCorners[" + std::to_string(c) + "] is not finite");
 
@@ -268,6 +267,7 @@ ContactTree decodeContactTree(ByteReader& in) {
     if (decoded + level.size() > n) fail("the coded stream holds more than the declared " + std::to_string(n) + " nodes");
     next.clear();
     const int dc = depthContext(d);
+    const double step = detail::latticeStep(tree, d), hsStep = step / 16.0;
     for (LevelCell& cell : level) {
       const std::array<float, 8>& corners = cell.corners;
       const std::uint64_t node = decoded++;

@@ -3,9 +3,12 @@
 // index i + 3j + 9k. The 8 points with all coordinates even are the cell's corners; the other
 // 19 are stored per interior node, in linear-index order ("pool slot").
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+
+#include "clod/contact_tree.h"
 
 namespace clod::detail {
 
@@ -42,6 +45,19 @@ constexpr std::array<std::array<std::uint8_t, 8>, 8> makeChildCornerSlots() {
   return table;
 }
 inline constexpr std::array<std::array<std::uint8_t, 8>, 8> kChildCornerSlot = makeChildCornerSlots();
+
+/// The step of the values a split node of this depth stores: tree.valueStep() (q), divided by 8
+/// per octave by which the cell side exceeds 16 errorAbs (by at most 2^24). Coarse cells are
+/// few, and a value rounded there would be inherited by every descendant whose field trilinear
+/// interpolation reproduces exactly (a flat face away from its edges): with the finer step
+/// those stay within ~1e-6 of the diagonal. Always <= q.
+inline double latticeStep(const ContactTree& tree, std::uint32_t depth) {
+  const double q = tree.valueStep();
+  const double ratio = tree.cellSize(depth) / (16.0 * tree.errorAbs);
+  if (!(q > 0.0) || !(ratio >= 2.0)) return q;
+  const int octaves = std::min(3 * std::ilogb(ratio), 24);  // floor(log2(ratio)) >= 1
+  return std::ldexp(q, -octaves);
+}
 
 /// The trilinear value at lattice point l of a cell with these corner values: the mean of the
 /// corners that share l's even coordinates (exact in double for the float corners of a tree).
