@@ -165,7 +165,9 @@ struct ContactTree {
   }
 
   // --- Quantisation (docs/contact-tree.md, "Compact storage") -------------------------------
-  /// Step q of the stored lattice values: the largest power of two <= errorAbs / 8. A lattice
+  /// Step q of the stored lattice values: the largest power of two <= errorAbs / 8 (split
+  /// cells larger than 32 errorAbs use finer steps, and half-space offsets steps of 1/1024 of
+  /// their cell's, docs/contact-tree.md "Compact storage"). A lattice
   /// value is stored as its trilinear prediction from the cell's corners plus an integer
   /// number of q (the bake file stores the integer), so it differs from the exact distance by
   /// at most q / 2 <= errorAbs / 16, and a field that trilinear interpolation reproduces (a
@@ -173,8 +175,6 @@ struct ContactTree {
   /// these values, so the refinement test and the stored bounds include the rounding. The
   /// root corners are exact floats. Derived from errorAbs; 0 for a default-constructed tree.
   double valueStep() const;
-  /// Step of the half-space offsets (relative to their prediction): valueStep() / 16.
-  double halfSpaceStep() const { return valueStep() / 16.0; }
   /// True when the corner values (of a cell of the given depth) prove, by the 1-Lipschitz
   /// property of a distance and allowing q/2 of rounding per corner, that no point of the cell
   /// lies within bandAbs of the surface. Such cells are never measured or split: they are

@@ -287,11 +287,11 @@ void Builder::measureCell(const PendingCell& cell, std::uint32_t depth, double* 
     if (!(n.norm() > 0.5)) n = Vec3::UnitZ();  // degenerate feature: any unit normal, fitError says how bad
     n.normalize();
     // Rounded as the bake file stores it (half_space_code.h): normal through its octahedral
-    // code, offset = prediction + a multiple of q/16. The fit is measured against the rounded
+    // code, offset = prediction + a multiple of step/1024. The fit is measured against the rounded
     // plane and rounded up, so it still bounds |plane - exact| at the lattice points.
     const std::array<std::int32_t, 2> oct = detail::encodeOctNormal(n.x(), n.y(), n.z());
     r.halfSpace.normal = detail::decodeOctNormal(oct[0], oct[1]);
-    const double hsStep = detail::latticeStep(tree_, depth) / 16.0;
+    const double hsStep = detail::latticeStep(tree_, depth) / detail::kOffsetStepDivisor;
     const double prediction = detail::offsetPrediction(cell.corners, r.split, r.lattice[13]);
     r.halfSpace.offset = detail::storedValue(prediction, detail::residualUnits(-dc, prediction, hsStep), hsStep);
     const Vec3 nr(r.halfSpace.normal[0], r.halfSpace.normal[1], r.halfSpace.normal[2]);

@@ -148,7 +148,7 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
   for (std::uint32_t d = 0; d < tree.depthCount(); ++d) {
     next.clear();
     const int dc = depthContext(d);
-    const double step = detail::latticeStep(tree, d), hsStep = step / 16.0;
+    const double step = detail::latticeStep(tree, d), hsStep = step / detail::kOffsetStepDivisor;
     for (std::uint32_t j = 0; j < level.size(); ++j) {
       const std::uint32_t node = tree.levelOffsets[d] + j;
       LevelCell cell = level[j];
@@ -267,7 +267,7 @@ ContactTree decodeContactTree(ByteReader& in) {
     if (decoded + level.size() > n) fail("the coded stream holds more than the declared " + std::to_string(n) + " nodes");
     next.clear();
     const int dc = depthContext(d);
-    const double step = detail::latticeStep(tree, d), hsStep = step / 16.0;
+    const double step = detail::latticeStep(tree, d), hsStep = step / detail::kOffsetStepDivisor;
     for (LevelCell& cell : level) {
       const std::array<float, 8>& corners = cell.corners;
       const std::uint64_t node = decoded++;

@@ -7,8 +7,8 @@
 //    floating-point normal vectors"), each coordinate rounded to a multiple of 1/32767; the
 //    decoded normal is normalised in double and stored as float. Angular error < 5e-5 rad.
 //  * offset: the centre estimate (-centre value of a split cell, else -trilinear centre value)
-//    plus an integer multiple of ContactTree::halfSpaceStep() (q / 16), rounded to nearest, so
-//    a flat face's plane (predicted exactly) keeps its float precision.
+//    plus an integer multiple of latticeStep / 1024 (lattice.h), rounded to nearest: the plane
+//    moves by at most 2^-14 eps_s (samples are placed on it, so it must stay that close).
 //  * fitError: fitError / h as a 16-bit code rounded up (ContactTree::encodeErrorRatio), so it
 //    stays an upper bound and keeps its relative precision (2^-7) however small it is.
 
@@ -21,6 +21,8 @@
 namespace clod::detail {
 
 inline constexpr double kOctScale = 32767.0;
+/// Offsets are stored in steps of latticeStep / kOffsetStepDivisor.
+inline constexpr double kOffsetStepDivisor = 1024.0;
 
 /// Octahedral code of a direction (need not be unit; a zero vector gives +z).
 inline std::array<std::int32_t, 2> encodeOctNormal(double x, double y, double z) {
