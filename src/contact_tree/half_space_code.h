@@ -15,6 +15,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #include "clod/contact_tree.h"
 
@@ -61,7 +62,9 @@ inline bool findOctCode(const std::array<float, 3>& n, std::array<std::int32_t, 
     for (int db = -1; db <= 1; ++db) {
       const std::int32_t a = guess[0] + da, b = guess[1] + db;
       if (std::abs(a) > 32767 || std::abs(b) > 32767) continue;
-      if (decodeOctNormal(a, b) == n) {
+      // Bit for bit: a zero component may decode as -0.0 from one code and +0.0 from another.
+      const std::array<float, 3> m = decodeOctNormal(a, b);
+      if (std::memcmp(m.data(), n.data(), sizeof(m)) == 0) {
         code = {a, b};
         return true;
       }
