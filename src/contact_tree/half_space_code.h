@@ -56,19 +56,21 @@ inline std::array<float, 3> decodeOctNormal(std::int32_t a, std::int32_t b) {
 /// the builder did not round).
 inline bool findOctCode(const std::array<float, 3>& n, std::array<std::int32_t, 2>& code) {
   const std::array<std::int32_t, 2> guess = encodeOctNormal(n[0], n[1], n[2]);
-  // Re-encoding a decoded normal returns its code except, rarely, one step off near the fold
-  // of the octahedron or a rounding tie: try the neighbours.
-  for (int da = -1; da <= 1; ++da)
-    for (int db = -1; db <= 1; ++db) {
-      const std::int32_t a = guess[0] + da, b = guess[1] + db;
-      if (std::abs(a) > 32767 || std::abs(b) > 32767) continue;
-      // Bit for bit: a zero component may decode as -0.0 from one code and +0.0 from another.
-      const std::array<float, 3> m = decodeOctNormal(a, b);
-      if (std::memcmp(m.data(), n.data(), sizeof(m)) == 0) {
-        code = {a, b};
-        return true;
+  // Re-encoding a decoded normal returns its code except, rarely, one step off at a rounding
+  // tie, or mirrored at the octahedron's corners and fold, where a component decodes as 0 and
+  // the sign of the code that produced it (-0.0 or +0.0) is lost: try those too.
+  for (int mirror = 0; mirror < 4; ++mirror)
+    for (int da = -1; da <= 1; ++da)
+      for (int db = -1; db <= 1; ++db) {
+        const std::int32_t a = ((mirror & 1) ? -guess[0] : guess[0]) + da, b = ((mirror & 2) ? -guess[1] : guess[1]) + db;
+        if (std::abs(a) > 32767 || std::abs(b) > 32767) continue;
+        // Bit for bit: a zero component may decode as -0.0 from one code and +0.0 from another.
+        const std::array<float, 3> m = decodeOctNormal(a, b);
+        if (std::memcmp(m.data(), n.data(), sizeof(m)) == 0) {
+          code = {a, b};
+          return true;
+        }
       }
-    }
   return false;
 }
 
