@@ -37,6 +37,7 @@
 
 #include <array>
 #include <bit>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -118,9 +119,10 @@ struct ContactTree {
   std::vector<ContactTreeNodeWord> nodeWords;
   /// Per node: its error bound divided by cellRadius(depth), as the upper 16 bits of an IEEE
   /// float (sign 0, 8-bit exponent, 7-bit mantissa), rounded up, so that the decoded bound is
-  /// never below the builder's and at most 2^-7 (0.8 %) above it; 0x3f80 (1.0) is the Lipschitz
-  /// bound of half the cell diagonal, which caps every bound except in cells where the builder
-  /// found the field discontinuous (open meshes, docs/contact-tree.md). Use errorBound().
+  /// never below the builder's and at most 2^-7 (0.8 %) above it; farErrorCode(depth) (just
+  /// above 1.0) is the Lipschitz bound of half the cell diagonal plus the value rounding q/2,
+  /// which caps every bound except in cells where the builder found the field discontinuous
+  /// (open meshes, docs/contact-tree.md). Use errorBound().
   std::vector<std::uint16_t> errorCode;
   std::vector<std::uint32_t> levelOffsets;  ///< size depthCount() + 1
 
@@ -162,6 +164,28 @@ struct ContactTree {
     return (node >> 6) < flatSurface.size() && ((flatSurface[node >> 6] >> (node & 63)) & 1u) != 0;
   }
 
+  // --- Quantisation (docs/contact-tree.md, "Compact storage") -------------------------------
+  /// Step q of the stored lattice values: the largest power of two <= errorAbs / 8 (split
+  /// cells larger than 32 errorAbs use finer steps, and half-space offsets steps of 1/1024 of
+  /// their cell's, docs/contact-tree.md "Compact storage"). A lattice
+  /// value is stored as its trilinear prediction from the cell's corners plus an integer
+  /// number of q (the bake file stores the integer), so it differs from the exact distance by
+  /// at most q / 2 <= errorAbs / 16, and a field that trilinear interpolation reproduces (a
+  /// flat face) keeps its float precision. The builder measures its interpolation errors with
+  /// these values, so the refinement test and the stored bounds include the rounding. The
+  /// root corners are exact floats. Derived from errorAbs; 0 for a default-constructed tree.
+  double valueStep() const;
+  /// True when the corner values (of a cell of the given depth) prove, by the 1-Lipschitz
+  /// property of a distance and allowing q/2 of rounding per corner, that no point of the cell
+  /// lies within bandAbs of the surface. Such cells are never measured or split: they are
+  /// leaves without a half-space whose bound is farErrorCode(depth). Both the builder and the
+  /// decoder evaluate it (the bake file does not store what it decides). O(1).
+  bool provenFar(const std::array<float, 8>& corners, std::uint32_t depth) const;
+  /// errorCode of a proven-far leaf: the Lipschitz bound of a 1-Lipschitz field interpolated
+  /// from values rounded by at most q/2, (D/2 + q/2) / (D/2), rounded up. Measured cells are
+  /// capped by it too, except where the field is discontinuous. O(1).
+  std::uint16_t farErrorCode(std::uint32_t depth) const;
+
   // --- Size ---------------------------------------------------------------------------------
   std::uint32_t nodeCount() const { return levelOffsets.empty() ? 0 : levelOffsets.back(); }
   /// Number of depths present (the deepest leaf's depth + 1); 0 for an empty tree.
@@ -188,8 +212,9 @@ struct ContactTree {
   /// Interpolation error bound of the node's cell, in mesh units: the largest |trilinear -
   /// exact| measured at the cell's test points times the gap factor (docs/contact-tree.md:
   /// 3x3x3 lattice + 8 octant centres), or, for a cell the builder proved far from the surface
-  /// without measuring, the Lipschitz bound of half the cell diagonal, which holds everywhere in
-  /// the cell for any 1-Lipschitz field; never more than that, except in cells where the field
+  /// without measuring, the Lipschitz bound of half the cell diagonal (plus the value rounding
+  /// q/2, see valueStep()), which holds everywhere in the cell for any 1-Lipschitz field;
+  /// never more than that, except in cells where the field
   /// is discontinuous (open meshes: the measured bound, uncapped). Rounded up by at most 0.8 %
   /// (errorCode). This is what a query stopped at this node reports, and what graceful
   /// degradation uses. `depth` must be the node's depth. O(1).

@@ -21,7 +21,8 @@ namespace clod {
 class MeshDistance;
 
 struct ContactTreeSettings {
-  /// eps_s, relative to the mesh's bounding-box diagonal. Must be finite and > 0.
+  /// eps_s, relative to the mesh's bounding-box diagonal. Must be finite and >= 1e-6 (the
+  /// stored values are integers of steps of eps_s / 8 or finer, see ContactTree::valueStep).
   double errorRel = 1e-3;
   /// Deepest allowed node (the root has depth 0). 1..20.
   std::uint32_t maxDepth = 12;

@@ -147,6 +147,34 @@ void ContactTree::buildLookupGrid(std::uint32_t depthCap) {
   }
 }
 
+double ContactTree::valueStep() const {
+  if (!(errorAbs > 0.0) || !std::isfinite(errorAbs)) return 0.0;
+  // The largest power of two <= errorAbs / 8: exact in binary, so a multiple k q is exact in
+  // double and, while |k| < 2^24, in float.
+  int exponent = 0;
+  (void)std::frexp(errorAbs / 8.0, &exponent);  // errorAbs / 8 = m 2^exponent, m in [0.5, 1)
+  return std::ldexp(1.0, exponent - 1);
+}
+
+bool ContactTree::provenFar(const std::array<float, 8>& corners, std::uint32_t depth) const {
+  // Every point x of the cell is within half a diagonal of its nearest corner c, so |d(x)| >=
+  // |d(c)| - D/2 >= |v_c| - q/2 - D/2. The relative slack covers the float rounding of the
+  // corner values (it was the only slack before values were rounded to q).
+  float minAbs = std::abs(corners[0]);
+  bool sameSign = true;
+  for (int c = 1; c < 8; ++c) {
+    minAbs = std::min(minAbs, std::abs(corners[c]));
+    sameSign = sameSign && ((corners[c] < 0.0f) == (corners[0] < 0.0f));
+  }
+  const double halfDiagonal = cellRadius(depth);
+  return sameSign && double(minAbs) * (1.0 - 1e-6) - 0.5 * valueStep() > bandAbs + halfDiagonal;
+}
+
+std::uint16_t ContactTree::farErrorCode(std::uint32_t depth) const {
+  // |d(x) - sum w_i v_i| <= sum w_i |x - c_i| + max |d(c_i) - v_i| <= D/2 + q/2.
+  return encodeErrorRatio(1.0 + 0.5 * valueStep() / cellRadius(depth));
+}
+
 ContactCell ContactTree::rootCell() const {
   CLOD_ASSERT(nodeCount() > 0);
   ContactCell cell;

@@ -10,6 +10,7 @@
 
 #include "clod/error.h"
 #include "clod/proximity.h"
+#include "half_space_code.h"
 #include "lattice.h"
 
 namespace clod {
@@ -27,10 +28,13 @@ constexpr double kSqrt3 = 1.7320508075688772;
 // measured, capped by the rigorous half-diagonal). docs/contact-tree.md has the measurements.
 constexpr double kGapFactor = 2.0;
 
-// A cell waiting to be processed: where it is and its (float-rounded, exact) corner values.
+// A cell waiting to be processed: where it is, its corner values as stored (rounded to the
+// value step q, ContactTree::valueStep) and as measured (float-rounded exact values: the
+// half-space fit and the discontinuity test compare exact values with each other).
 struct PendingCell {
   std::uint32_t index[3];
   std::array<float, 8> corners;
+  std::array<float, 8> exactCorners;
 };
 
 // What processing one cell decided. Written by one TBB task, read by the serial linking pass.
@@ -40,17 +44,21 @@ struct CellResult {
   bool measured = false;
   bool discontinuous = false;
   bool aboveError = false;
+  bool far = false;
   float error = 0.0f;
   float bandError = 0.0f;
   std::uint32_t queries = 0;
   ContactHalfSpace halfSpace{};
-  std::array<float, kLatticeSize> lattice{};
+  std::array<float, kLatticeSize> lattice{};       // rounded to q: the children's corners
+  std::array<float, kLatticeSize> latticeExact{};  // as measured
 };
 
 void checkSettings(const ContactTreeSettings& s) {
   auto bad = [](const std::string& what) { throw Error(ErrorCode::kInvalidArgument, "contact tree settings: " + what); };
-  if (!(std::isfinite(s.errorRel) && s.errorRel > 0.0))
-    bad("errorRel " + std::to_string(s.errorRel) + " must be finite and > 0");
+  // Stored values are integers of steps >= q 2^-24 (detail::latticeStep) that the codec keeps
+  // below 2^46: with errorRel >= 1e-6 they stay below 1.2 diagonals / (2^-28 eps) < 2^39.
+  if (!(std::isfinite(s.errorRel) && s.errorRel >= 1e-6))
+    bad("errorRel " + std::to_string(s.errorRel) + " must be finite and >= 1e-6");
   if (s.maxDepth < 1 || s.maxDepth > 20) bad("maxDepth " + std::to_string(s.maxDepth) + " must be in 1..20");
   if (!(std::isfinite(s.bandRel) && s.bandRel >= 0.0))
     bad("bandRel " + std::to_string(s.bandRel) + " must be finite and >= 0");
@@ -105,22 +113,15 @@ private:
 };
 
 bool Builder::needsMeasuring(const PendingCell& cell, std::uint32_t depth, CellResult& r) const {
-  const double h = tree_.cellSize(depth);
-  const double diagonal = kSqrt3 * h;
-  float minAbs = std::abs(cell.corners[0]);
-  bool sameSign = true;
-  for (int c = 1; c < 8; ++c) {
-    minAbs = std::min(minAbs, std::abs(cell.corners[c]));
-    sameSign = sameSign && ((cell.corners[c] < 0.0f) == (cell.corners[0] < 0.0f));
-  }
   // Lipschitz: every point x of the cell is within half a diagonal of its nearest corner c, so
-  // |d(x)| >= |d(c)| - diagonal/2. If all corners exceed band + diagonal/2 (same sign), no
-  // point of the cell is in the band and the surface does not cross it. The relative slack
-  // covers the float rounding of the corner values.
-  if (sameSign && double(minAbs) * (1.0 - 1e-6) > tree_.bandAbs + 0.5 * diagonal) {
+  // |d(x)| >= |d(c)| - diagonal/2 (ContactTree::provenFar, which also allows for the rounding
+  // of the stored corners). If all corners exceed band + diagonal/2 (same sign), no point of
+  // the cell is in the band and the surface does not cross it.
+  if (tree_.provenFar(cell.corners, depth)) {
     // Rigorous for any 1-Lipschitz field: |d(x) - sum w_i d(c_i)| <= sum w_i |x - c_i| <=
-    // sqrt(sum w_i |x - c_i|^2) = h sqrt(sum_axes t(1-t)) <= h sqrt(3)/2.
-    r.error = static_cast<float>(0.5 * diagonal);
+    // sqrt(sum w_i |x - c_i|^2) = h sqrt(sum_axes t(1-t)) <= h sqrt(3)/2, plus q/2 for the
+    // rounded corners (farErrorCode). The decoder derives all of it from the corners.
+    r.far = true;
     return false;
   }
   r.measured = true;
@@ -134,7 +135,7 @@ int Builder::inferSign(const PendingCell& cell, std::uint32_t depth, const Vec3&
   const double h = tree_.cellSize(depth);
   for (int c = 0; c < 8; ++c) {
     const double reach = h * (t - Vec3(c & 1, (c >> 1) & 1, (c >> 2) & 1)).norm();
-    const double v = cell.corners[c];
+    const double v = cell.exactCorners[c];
     if (std::abs(v) * (1.0 - 1e-6) > reach + 1e-9 * h) return v < 0.0 ? -1 : 1;
   }
   return 0;
@@ -215,7 +216,8 @@ void Builder::measureCell(const PendingCell& cell, std::uint32_t depth, double* 
     ++r.queries;
     return exactQuery(cell, depth, t).signedDistance;
   };
-  for (int c = 0; c < 8; ++c) exact[detail::parentCornerLattice(c)] = cell.corners[c];
+  // Corners as measured (the stored, rounded corners only enter the interpolation below).
+  for (int c = 0; c < 8; ++c) exact[detail::parentCornerLattice(c)] = cell.exactCorners[c];
   ++r.queries;
   const MeshDistance::Signed centre = exactQuery(cell, depth, Vec3::Constant(0.5));
   exact[13] = centre.signedDistance;
@@ -251,9 +253,16 @@ void Builder::measureCell(const PendingCell& cell, std::uint32_t depth, double* 
   }
 
   // Measured values cannot exceed the rigorous Lipschitz bound unless the field jumps.
-  r.error = static_cast<float>(r.discontinuous ? kGapFactor * error : std::min(kGapFactor * error, 0.5 * diagonal));
+  const double step = detail::latticeStep(tree_, depth);
+  r.error = static_cast<float>(r.discontinuous ? kGapFactor * error : std::min(kGapFactor * error, 0.5 * (diagonal + step)));
   r.bandError = static_cast<float>(bandError);
-  for (int l = 0; l < kLatticeSize; ++l) r.lattice[l] = static_cast<float>(exact[l]);
+  // Stored as the bake file stores them: prediction from the corners + a multiple of q.
+  for (int l = 0; l < kLatticeSize; ++l) {
+    r.latticeExact[l] = static_cast<float>(exact[l]);
+    const double prediction = detail::latticePrediction(cell.corners, l);
+    r.lattice[l] = detail::storedValue(prediction, detail::residualUnits(exact[l], prediction, step), step);
+  }
+  for (int c = 0; c < 8; ++c) r.lattice[detail::parentCornerLattice(c)] = cell.corners[c];
 
   // The surface crosses the cell iff some point of it has d = 0; every point is within half a
   // diagonal of the centre, so |d(centre)| <= diagonal/2 is necessary (and with a sign change
@@ -264,6 +273,12 @@ void Builder::measureCell(const PendingCell& cell, std::uint32_t depth, double* 
   bool signChange = false;
   for (int l = 1; l < kLatticeSize; ++l) signChange = signChange || ((exact[l] < 0.0) != (exact[0] < 0.0));
   const double dc = centre.signedDistance;
+  const bool canSplit = depth < settings_.maxDepth &&
+                        (!r.discontinuous || diagonal > settings_.discontinuityStopRel * tree_.meshDiagonal);
+  const bool overError = kGapFactor * bandError > tree_.errorAbs;
+  r.split = overError && canSplit;
+  r.aboveError = !r.split && overError && !r.discontinuous;
+
   if (std::abs(dc) <= 0.5 * diagonal * (1.0 + 1e-9) || signChange) {
     r.surface = true;
     Vec3 n = centre.closest.normal;
@@ -271,22 +286,23 @@ void Builder::measureCell(const PendingCell& cell, std::uint32_t depth, double* 
     if (std::abs(dc) > 1e-9 * diagonal && toCentre.norm() > 0.0) n = toCentre / dc;
     if (!(n.norm() > 0.5)) n = Vec3::UnitZ();  // degenerate feature: any unit normal, fitError says how bad
     n.normalize();
+    // Rounded as the bake file stores it (half_space_code.h): normal through its octahedral
+    // code, offset = prediction + a multiple of step/1024. The fit is measured against the rounded
+    // plane and rounded up, so it still bounds |plane - exact| at the lattice points.
+    const std::array<std::int32_t, 2> oct = detail::encodeOctNormal(n.x(), n.y(), n.z());
+    r.halfSpace.normal = detail::decodeOctNormal(oct[0], oct[1]);
+    const double hsStep = detail::latticeStep(tree_, depth) / detail::kOffsetStepDivisor;
+    const double prediction = detail::offsetPrediction(cell.corners, r.split, r.lattice[13]);
+    r.halfSpace.offset = detail::storedValue(prediction, detail::residualUnits(-dc, prediction, hsStep), hsStep);
+    const Vec3 nr(r.halfSpace.normal[0], r.halfSpace.normal[1], r.halfSpace.normal[2]);
     double fit = 0.0;
     for (int l = 0; l < kLatticeSize; ++l) {
       if (std::abs(exact[l]) > diagonal) continue;
       const Vec3 offset = 0.5 * h * Vec3((l % 3) - 1.0, ((l / 3) % 3) - 1.0, (l / 9) - 1.0);
-      fit = std::max(fit, std::abs(n.dot(offset) + dc - exact[l]));
+      fit = std::max(fit, std::abs(nr.dot(offset) - double(r.halfSpace.offset) - exact[l]));
     }
-    r.halfSpace.normal = {static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z())};
-    r.halfSpace.offset = static_cast<float>(-dc);
-    r.halfSpace.fitError = static_cast<float>(fit);
+    r.halfSpace.fitError = detail::fitErrorFromCode(ContactTree::encodeErrorRatio(fit / h), h);
   }
-
-  const bool canSplit = depth < settings_.maxDepth &&
-                        (!r.discontinuous || diagonal > settings_.discontinuityStopRel * tree_.meshDiagonal);
-  const bool overError = kGapFactor * bandError > tree_.errorAbs;
-  r.split = overError && canSplit;
-  r.aboveError = !r.split && overError && !r.discontinuous;
 }
 
 ContactTree Builder::build(ContactTreeBuildStats* stats) {
@@ -304,7 +320,9 @@ ContactTree Builder::build(ContactTreeBuildStats* stats) {
   std::vector<PendingCell> frontier(1);
   for (int c = 0; c < 8; ++c) {
     const Vec3 corner = tree_.origin + tree_.rootSize * Vec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
-    frontier[0].corners[c] = static_cast<float>(distance_.signedDistance(corner));
+    const double d = distance_.signedDistance(corner);
+    frontier[0].exactCorners[c] = static_cast<float>(d);
+    frontier[0].corners[c] = static_cast<float>(d);
     ++st.distanceQueries;
   }
   tree_.rootCorners = frontier[0].corners;
@@ -329,10 +347,12 @@ ContactTree Builder::build(ContactTreeBuildStats* stats) {
       st.distanceQueries += r.queries;
       st.measuredCells += r.measured;
       st.discontinuousCells += r.discontinuous;
-      // Capped at the Lipschitz bound D/2 (ratio 1) except where the field jumps; the cap also
-      // absorbs the float rounding of r.error = D/2, which could otherwise round the code up.
-      const double ratio = double(r.error) / tree_.cellRadius(depth);
-      tree_.errorCode.push_back(ContactTree::encodeErrorRatio(r.discontinuous ? ratio : std::min(ratio, 1.0)));
+      // Capped at the Lipschitz bound D/2 + q/2 (farErrorCode) except where the field jumps;
+      // the cap also absorbs the float rounding of r.error, which could otherwise round the
+      // code up. Codes are monotone in the ratio, so the cap applies to the codes.
+      const std::uint16_t farCode = tree_.farErrorCode(depth);
+      const std::uint16_t code = r.far ? farCode : ContactTree::encodeErrorRatio(double(r.error) / tree_.cellRadius(depth));
+      tree_.errorCode.push_back(r.discontinuous ? code : std::min(code, farCode));
       surface.push_back(r.surface ? 1 : 0);
       if (r.surface) tree_.halfSpaces.push_back(r.halfSpace);
       interior.push_back(r.split ? 1 : 0);
@@ -349,7 +369,10 @@ ContactTree Builder::build(ContactTreeBuildStats* stats) {
       for (int o = 0; o < 8; ++o) {
         PendingCell child;
         for (int a = 0; a < 3; ++a) child.index[a] = 2 * frontier[i].index[a] + ((o >> a) & 1);
-        for (int c = 0; c < 8; ++c) child.corners[c] = r.lattice[childCornerLattice(o, c)];
+        for (int c = 0; c < 8; ++c) {
+          child.corners[c] = r.lattice[childCornerLattice(o, c)];
+          child.exactCorners[c] = r.latticeExact[childCornerLattice(o, c)];
+        }
         next.push_back(child);
       }
     }

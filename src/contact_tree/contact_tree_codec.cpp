@@ -2,16 +2,133 @@
 
 #include <bit>
 #include <cmath>
-#include <vector>
+#include <cstdlib>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "clod/error.h"
+#include "half_space_code.h"
+#include "lattice.h"
+#include "range_coder.h"
 
 namespace clod {
 
-static_assert(sizeof(ContactHalfSpace) == 20, "half-spaces are encoded as 5 packed floats");
+namespace {
+
+using detail::BitModel;
+using detail::IntModel;
+using detail::kLatticeSize;
+using detail::kLatticeSlot;
+
+// Integers the codec handles stay below 2^46 in magnitude, far inside int64 and the coder's
+// 2^48 cap, so sums of eight of them cannot overflow.
+constexpr double kMaxUnits = 70368744177664.0;  // 2^46
+constexpr int kDepthContexts = 16;
+
+// Adaptive models of everything the stream holds; encoder and decoder start from the same
+// state and update them identically. Contexts: what the decoder already knows about a node
+// (its depth, whether it is split, where the field's zero set is).
+struct Models {
+  BitModel interior[kDepthContexts];
+  BitModel surface[2][3][2];  // [split][|centre estimate| / radius bucket][corner signs differ]
+  BitModel errorHigh[2][kDepthContexts][128];
+  BitModel errorLow[2][8][256];  // [split][low 3 bits of the high byte]
+  IntModel lattice[3][kDepthContexts];  // [odd coordinates - 1: edge, face, centre][depth]
+  IntModel normal[2][2];                // [split][component]
+  IntModel offset[2];
+  BitModel fitHigh[2][kDepthContexts][128];
+  BitModel fitLow[2][8][256];
+  BitModel normalFromAncestor[2][2];  // [split][the cell has an ancestor with a half-space]
+};
+
+int depthContext(std::uint32_t depth) { return depth < kDepthContexts ? static_cast<int>(depth) : kDepthContexts - 1; }
+
+// The integer residual of a stored value (storedValue(prediction, units, step) == value), or
+// false if there is none in range.
+bool unitsOf(float value, double prediction, double step, std::int64_t& units) {
+  const double u = (double(value) - prediction) / step;
+  if (!(std::abs(u) < kMaxUnits)) return false;
+  units = std::llround(u);
+  return detail::storedValue(prediction, units, step) == value;
+}
+
+int latticeClass(int l) { return (l % 3 == 1) + ((l / 3) % 3 == 1) + (l / 9 == 1) - 1; }
+
+struct NodeGuess {
+  int surfaceBucket = 0;
+  int signChange = 0;
+  double centre = 0.0;  // trilinear value at the cell centre
+  std::array<std::int32_t, 2> normal{0, 0};
+};
+
+// What the corners say about a node before anything of it is read.
+NodeGuess guessNode(const ContactTree& tree, const std::array<float, 8>& corners, std::uint32_t depth) {
+  NodeGuess g;
+  double sum = 0.0, gx = 0.0, gy = 0.0, gz = 0.0;
+  for (int c = 0; c < 8; ++c) {
+    const double v = corners[c];
+    sum += v;
+    gx += (c & 1) ? v : -v;
+    gy += ((c >> 1) & 1) ? v : -v;
+    gz += ((c >> 2) & 1) ? v : -v;
+    g.signChange |= (corners[c] < 0.0f) != (corners[0] < 0.0f);
+  }
+  g.centre = sum / 8.0;
+  const double ratio = std::abs(g.centre) / tree.cellRadius(depth);
+  g.surfaceBucket = ratio < 0.5 ? 0 : ratio < 1.5 ? 1 : 2;
+  g.normal = detail::encodeOctNormal(gx, gy, gz);  // direction of the trilinear gradient at the centre
+  return g;
+}
+
+// A node of the level being coded: its corners and the normal code of its nearest ancestor
+// with a half-space (the surface that crosses a cell crosses its parent, and its normal varies
+// little between them, so it predicts the node's normal better than the corners do).
+struct LevelCell {
+  std::array<float, 8> corners{};
+  std::array<std::int32_t, 2> ancestorNormal{0, 0};
+  bool hasAncestorNormal = false;
+};
+
+// The children of a split cell, with corners from its 27 lattice values.
+void pushChildren(const std::array<float, kLatticeSize>& lattice, const LevelCell& parent, std::vector<LevelCell>& next) {
+  for (int o = 0; o < 8; ++o) {
+    LevelCell child;
+    for (int c = 0; c < 8; ++c) child.corners[c] = lattice[detail::childCornerLattice(o, c)];
+    child.ancestorNormal = parent.ancestorNormal;
+    child.hasAncestorNormal = parent.hasAncestorNormal;
+    next.push_back(child);
+  }
+}
+
+[[noreturn]] void refuse(const std::string& what) { throw Error(ErrorCode::kInvalidArgument, "contact tree: " + what); }
+
+}  // namespace
 
 void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
+  // The tree's shape must be consistent before the walk below can index its arrays.
+  const std::uint64_t n = tree.nodeCount();
+  if (n == 0 || tree.levelOffsets.front() != 0 || tree.levelOffsets[1] != 1) refuse("levelOffsets must start 0, 1");
+  if (tree.nodeWords.size() != (n + 63) / 64 || tree.errorCode.size() != n) refuse("per-node arrays do not match the node count");
+  if (tree.depthCount() > tree.maxDepth + 1) refuse("deeper than maxDepth");
+  std::uint64_t interiorCount = 0, surfaceCount = 0;
+  for (std::uint32_t d = 0; d < tree.depthCount(); ++d) {
+    std::uint64_t split = 0;
+    if (tree.levelOffsets[d + 1] <= tree.levelOffsets[d]) refuse("levelOffsets do not increase");
+    for (std::uint32_t i = tree.levelOffsets[d]; i < tree.levelOffsets[d + 1]; ++i) {
+      split += !tree.isLeaf(i);
+      surfaceCount += tree.halfSpaceIndex(i) != kNoHalfSpace;
+    }
+    interiorCount += split;
+    const std::uint64_t nextSize = d + 1 < tree.depthCount() ? tree.levelOffsets[d + 2] - tree.levelOffsets[d + 1] : 0;
+    if (8 * split != nextSize) refuse("level " + std::to_string(d + 1) + " does not hold 8 children per interior node of level " + std::to_string(d));
+  }
+  if (tree.lattice.size() != interiorCount * kContactTreeLatticePerNode) refuse("lattice size does not match the interior nodes");
+  if (tree.halfSpaces.size() != surfaceCount) refuse("halfSpaces size does not match the surface bitmap");
+  if (!(tree.valueStep() > 0.0)) refuse("errorAbs is not finite and > 0");
+  for (float v : tree.rootCorners)
+    if (!std::isfinite(v)) refuse("root corner value is not finite");
+
   out.write<std::uint32_t>(kContactTreeCodecVersion);
   for (int a = 0; a < 3; ++a) out.write<double>(tree.origin[a]);
   out.write<double>(tree.rootSize);
@@ -20,17 +137,83 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
   out.write<double>(tree.bandAbs);
   out.write<std::uint32_t>(tree.maxDepth);
   for (float v : tree.rootCorners) out.write<float>(v);
-  out.writeArray(tree.levelOffsets);
-  std::vector<std::uint64_t> interior(tree.nodeWords.size()), surface(tree.nodeWords.size());
-  for (std::size_t w = 0; w < tree.nodeWords.size(); ++w) {
-    interior[w] = tree.nodeWords[w].interior;
-    surface[w] = tree.nodeWords[w].surface;
+  out.write<std::uint32_t>(static_cast<std::uint32_t>(n));
+  out.write<std::uint32_t>(tree.depthCount());
+
+  auto models = std::make_unique<Models>();
+  detail::RangeEncoder enc;
+  std::vector<LevelCell> level(1), next;
+  level[0].corners = tree.rootCorners;
+  std::array<float, kLatticeSize> lattice{};
+  for (std::uint32_t d = 0; d < tree.depthCount(); ++d) {
+    next.clear();
+    const int dc = depthContext(d);
+    const double step = detail::latticeStep(tree, d), hsStep = step / detail::kOffsetStepDivisor;
+    for (std::uint32_t j = 0; j < level.size(); ++j) {
+      const std::uint32_t node = tree.levelOffsets[d] + j;
+      LevelCell cell = level[j];
+      const std::array<float, 8>& corners = cell.corners;
+      const bool split = !tree.isLeaf(node);
+      const ContactHalfSpace* hs = tree.halfSpace(node);
+      const std::uint16_t code = tree.errorCode[node];
+      auto bad = [&](const std::string& what) { refuse("node " + std::to_string(node) + ": " + what); };
+      if (tree.provenFar(corners, d)) {
+        // Derived by the decoder: a proven-far cell is a leaf without a half-space.
+        if (split || hs || code != tree.farErrorCode(d)) bad("its corners prove it far from the surface, but it is split, has a half-space or another error bound");
+        continue;
+      }
+      if (d == tree.maxDepth && split) bad("split at maxDepth");
+      if (d < tree.maxDepth) enc.encodeBit(models->interior[dc], split ? 1u : 0u);
+      const NodeGuess guess = guessNode(tree, corners, d);
+      enc.encodeBit(models->surface[split][guess.surfaceBucket][guess.signChange], hs ? 1u : 0u);
+      if (code > 0x7f7f) bad("error code is not a finite bound");
+      enc.encodeTree(models->errorHigh[split][dc], 7, code >> 8);
+      enc.encodeTree(models->errorLow[split][(code >> 8) & 7u], 8, code & 0xffu);
+
+      if (hs) {
+        std::array<std::int32_t, 2> oct{};
+        if (!detail::findOctCode(hs->normal, oct)) bad("half-space normal is not one the octahedral code stores");
+        // Predicted by the nearest ancestor's normal or by the trilinear gradient, whichever is
+        // closer (one adaptive bit says which).
+        const auto gap = [&](const std::array<std::int32_t, 2>& p) { return std::abs(oct[0] - p[0]) + std::abs(oct[1] - p[1]); };
+        const bool fromAncestor = cell.hasAncestorNormal && gap(cell.ancestorNormal) <= gap(guess.normal);
+        enc.encodeBit(models->normalFromAncestor[split][cell.hasAncestorNormal], fromAncestor ? 1u : 0u);
+        const std::array<std::int32_t, 2> prior = fromAncestor ? cell.ancestorNormal : guess.normal;
+        enc.encodeInt(models->normal[split][0], oct[0] - prior[0]);
+        enc.encodeInt(models->normal[split][1], oct[1] - prior[1]);
+        cell.ancestorNormal = oct;
+        cell.hasAncestorNormal = true;
+      }
+      if (split) {
+        const std::uint32_t block = (tree.firstChild(node) - 1) / 8;
+        for (int l = 0; l < kLatticeSize; ++l) {
+          if (kLatticeSlot[l] < 0) continue;
+          const float v = tree.lattice[std::size_t{block} * kContactTreeLatticePerNode + kLatticeSlot[l]];
+          std::int64_t u = 0;
+          if (!unitsOf(v, detail::latticePrediction(corners, l), step, u)) bad("lattice value is not its prediction plus a multiple of the value step");
+          enc.encodeInt(models->lattice[latticeClass(l)][dc], u);
+          lattice[l] = v;
+        }
+        for (int c = 0; c < 8; ++c) lattice[detail::parentCornerLattice(c)] = corners[c];
+        pushChildren(lattice, cell, next);
+      }
+      if (hs) {
+        // Offset = -d(centre): predicted by the stored centre value of a split cell, else by
+        // the trilinear value at the centre.
+        std::int64_t offsetUnits = 0;
+        std::uint16_t fitCode = 0;
+        if (!unitsOf(hs->offset, detail::offsetPrediction(corners, split, lattice[13]), hsStep, offsetUnits))
+          bad("half-space offset is not its prediction plus a multiple of the half-space step");
+        if (!detail::findFitCode(hs->fitError, tree.cellSize(d), fitCode)) bad("half-space fit error is not one the codec stores");
+        enc.encodeInt(models->offset[split], offsetUnits);
+        enc.encodeTree(models->fitHigh[split][dc], 7, fitCode >> 8u);
+        enc.encodeTree(models->fitLow[split][(fitCode >> 8) & 7u], 8, fitCode & 0xffu);
+      }
+    }
+    level.swap(next);
   }
-  out.writeArray(interior);
-  out.writeArray(surface);
-  out.writeArray(tree.errorCode);
-  out.writeArray(tree.lattice);
-  out.writeArray(tree.halfSpaces);
+  const std::vector<std::byte> coded = enc.finish();
+  out.writeArray(coded);
 }
 
 ContactTree decodeContactTree(ByteReader& in) {
@@ -38,7 +221,8 @@ ContactTree decodeContactTree(ByteReader& in) {
   const auto version = in.read<std::uint32_t>();
   if (version != kContactTreeCodecVersion) {
     throw Error(ErrorCode::kBakeVersion, in.context() + ": contact tree: version " + std::to_string(version) +
-                                             " is not the supported version " + std::to_string(kContactTreeCodecVersion));
+                                             " is not the supported version " + std::to_string(kContactTreeCodecVersion) +
+                                             (version < kContactTreeCodecVersion ? " (an older, uncompressed layout): re-bake the mesh" : ""));
   }
   ContactTree tree;
   for (int a = 0; a < 3; ++a) tree.origin[a] = in.read<double>();
@@ -48,12 +232,9 @@ ContactTree decodeContactTree(ByteReader& in) {
   tree.bandAbs = in.read<double>();
   tree.maxDepth = in.read<std::uint32_t>();
   for (float& v : tree.rootCorners) v = in.read<float>();
-  tree.levelOffsets = in.readArray<std::uint32_t>();
-  const auto interiorBits = in.readArray<std::uint64_t>();
-  const auto surfaceBits = in.readArray<std::uint64_t>();
-  tree.errorCode = in.readArray<std::uint16_t>();
-  tree.lattice = in.readArray<float>();
-  tree.halfSpaces = in.readArray<ContactHalfSpace>();
+  const std::uint32_t n = in.read<std::uint32_t>();
+  const std::uint32_t depths = in.read<std::uint32_t>();
+  const std::vector<std::byte> coded = in.readArray<std::byte>();
 
   if (!tree.origin.allFinite()) fail("origin is not finite");
   if (!(std::isfinite(tree.rootSize) && tree.rootSize > 0.0)) fail("rootSize " + std::to_string(tree.rootSize) + " is not finite and > 0");
@@ -61,52 +242,92 @@ ContactTree decodeContactTree(ByteReader& in) {
   if (!(std::isfinite(tree.errorAbs) && tree.errorAbs > 0.0)) fail("errorAbs is not finite and > 0");
   if (!(std::isfinite(tree.bandAbs) && tree.bandAbs >= 0.0)) fail("bandAbs is not finite and >= 0");
   if (tree.maxDepth < 1 || tree.maxDepth > 20) fail("maxDepth " + std::to_string(tree.maxDepth) + " is outside 1..20");
+  if (depths < 1 || depths > tree.maxDepth + 1) fail(std::to_string(depths) + " depths for maxDepth " + std::to_string(tree.maxDepth));
+  // Every split node codes at least 20 adaptive decisions of > 0.0109 bits each and brings 8
+  // nodes, so a stream of B bytes holds fewer than 1 + 8 * 8B / 0.218 < 300 B + 64 nodes: a
+  // larger count is refused before anything of that size is allocated.
+  if (n < 1 || n > 0xfffffff0u || n > 320.0 * double(coded.size()) + 64.0)
+    fail("node count " + std::to_string(n) + " is impossible for a coded stream of " + std::to_string(coded.size()) + " bytes");
   for (int c = 0; c < 8; ++c)
     if (!std::isfinite(tree.rootCorners[c])) fail("rootCorners[" + std::to_string(c) + "] is not finite");
 
-  const auto& levels = tree.levelOffsets;
-  if (levels.size() < 2 || levels.size() > tree.maxDepth + 2) fail("levelOffsets has " + std::to_string(levels.size()) + " entries for maxDepth " + std::to_string(tree.maxDepth));
-  if (levels.front() != 0 || levels[1] != 1) fail("levelOffsets must start 0, 1");
-  const std::uint64_t n = levels.back();
-  if (n > 0xfffffff0u) fail("node count " + std::to_string(n) + " exceeds 32-bit indices");
-  const std::uint64_t words = (n + 63) / 64;
-  if (interiorBits.size() != words) fail("interior bitmap has " + std::to_string(interiorBits.size()) + " words for " + std::to_string(n) + " nodes");
-  if (surfaceBits.size() != words) fail("surface bitmap has " + std::to_string(surfaceBits.size()) + " words for " + std::to_string(n) + " nodes");
-  if (n % 64 != 0 && ((interiorBits.back() | surfaceBits.back()) >> (n % 64)) != 0) fail("bitmaps have bits set past the last node");
-  if (tree.errorCode.size() != n) fail("errorCode has " + std::to_string(tree.errorCode.size()) + " entries for " + std::to_string(n) + " nodes");
-  for (std::size_t i = 0; i < tree.errorCode.size(); ++i)
-    if (tree.errorCode[i] > 0x7f7f) fail("errorCode[" + std::to_string(i) + "] is not a finite bound >= 0");
-
-  tree.nodeWords.resize(words);
-  std::uint64_t interior = 0, surfaceCount = 0;
-  for (std::size_t w = 0; w < words; ++w) {
-    tree.nodeWords[w] = ContactTreeNodeWord{interiorBits[w], surfaceBits[w], static_cast<std::uint32_t>(interior),
-                                            static_cast<std::uint32_t>(surfaceCount)};
-    interior += static_cast<std::uint64_t>(std::popcount(interiorBits[w]));
-    surfaceCount += static_cast<std::uint64_t>(std::popcount(surfaceBits[w]));
+  auto models = std::make_unique<Models>();
+  detail::RangeDecoder dec(coded, in.context() + ": contact tree");
+  std::vector<std::uint8_t> interiorFlags, surfaceFlags;
+  interiorFlags.reserve(n);
+  surfaceFlags.reserve(n);
+  tree.errorCode.reserve(n);
+  tree.levelOffsets.push_back(0);
+  std::vector<LevelCell> level(1), next;
+  level[0].corners = tree.rootCorners;
+  std::array<float, kLatticeSize> lattice{};
+  std::uint64_t decoded = 0;
+  for (std::uint32_t d = 0; !level.empty(); ++d) {
+    if (d >= depths) fail("the tree is deeper than its " + std::to_string(depths) + " declared depths");
+    if (decoded + level.size() > n) fail("the coded stream holds more than the declared " + std::to_string(n) + " nodes");
+    next.clear();
+    const int dc = depthContext(d);
+    const double step = detail::latticeStep(tree, d), hsStep = step / detail::kOffsetStepDivisor;
+    for (LevelCell& cell : level) {
+      const std::array<float, 8>& corners = cell.corners;
+      const std::uint64_t node = decoded++;
+      if (tree.provenFar(corners, d)) {
+        tree.errorCode.push_back(tree.farErrorCode(d));
+        interiorFlags.push_back(0);
+        surfaceFlags.push_back(0);
+        continue;
+      }
+      const bool split = d < tree.maxDepth && dec.decodeBit(models->interior[dc]) != 0;
+      const NodeGuess guess = guessNode(tree, corners, d);
+      const bool surface = dec.decodeBit(models->surface[split][guess.surfaceBucket][guess.signChange]) != 0;
+      const std::uint32_t high = dec.decodeTree(models->errorHigh[split][dc], 7);
+      const std::uint32_t code = (high << 8) | dec.decodeTree(models->errorLow[split][high & 7u], 8);
+      if (code > 0x7f7f) fail("errorCode[" + std::to_string(node) + "] is not a finite bound >= 0");
+      tree.errorCode.push_back(static_cast<std::uint16_t>(code));
+      interiorFlags.push_back(split ? 1 : 0);
+      surfaceFlags.push_back(surface ? 1 : 0);
+      ContactHalfSpace hs{};
+      if (surface) {
+        const bool fromAncestor = dec.decodeBit(models->normalFromAncestor[split][cell.hasAncestorNormal]) != 0;
+        if (fromAncestor && !cell.hasAncestorNormal) fail("node " + std::to_string(node) + " refers to an ancestor normal it does not have");
+        const std::array<std::int32_t, 2> prior = fromAncestor ? cell.ancestorNormal : guess.normal;
+        const std::int64_t a = prior[0] + dec.decodeInt(models->normal[split][0]);
+        const std::int64_t b = prior[1] + dec.decodeInt(models->normal[split][1]);
+        if (std::abs(a) > 32767 || std::abs(b) > 32767) fail("half-space normal code of node " + std::to_string(node) + " is out of range");
+        cell.ancestorNormal = {static_cast<std::int32_t>(a), static_cast<std::int32_t>(b)};
+        cell.hasAncestorNormal = true;
+        hs.normal = detail::decodeOctNormal(cell.ancestorNormal[0], cell.ancestorNormal[1]);
+      }
+      if (split) {
+        for (int l = 0; l < kLatticeSize; ++l) {
+          if (kLatticeSlot[l] < 0) continue;
+          const std::int64_t u = dec.decodeInt(models->lattice[latticeClass(l)][dc]);
+          const float v = detail::storedValue(detail::latticePrediction(corners, l), u, step);
+          if (!(std::abs(double(u)) < kMaxUnits) || !std::isfinite(v)) fail("lattice value of node " + std::to_string(node) + " is out of range");
+          lattice[l] = v;
+          tree.lattice.push_back(v);
+        }
+        for (int c = 0; c < 8; ++c) lattice[detail::parentCornerLattice(c)] = corners[c];
+        pushChildren(lattice, cell, next);
+      }
+      if (surface) {
+        const std::int64_t offsetUnits = dec.decodeInt(models->offset[split]);
+        const std::uint32_t fitHigh = dec.decodeTree(models->fitHigh[split][dc], 7);
+        const std::uint32_t fitCode = (fitHigh << 8) | dec.decodeTree(models->fitLow[split][fitHigh & 7u], 8);
+        if (!(std::abs(double(offsetUnits)) < kMaxUnits) || fitCode > 0x7f7f) fail("half-space of node " + std::to_string(node) + " is out of range");
+        hs.offset = detail::storedValue(detail::offsetPrediction(corners, split, lattice[13]), offsetUnits, hsStep);
+        hs.fitError = detail::fitErrorFromCode(static_cast<std::uint16_t>(fitCode), tree.cellSize(d));
+        if (!std::isfinite(hs.offset) || !std::isfinite(hs.fitError)) fail("half-space of node " + std::to_string(node) + " is not finite");
+        tree.halfSpaces.push_back(hs);
+      }
+    }
+    tree.levelOffsets.push_back(static_cast<std::uint32_t>(decoded));
+    level.swap(next);
   }
-  // Breadth-first layout: level d + 1 holds exactly the children of level d's interior nodes
-  // (8 each), which is what lets a query find children and lattice blocks by rank.
-  for (std::size_t d = 0; d + 1 < levels.size(); ++d) {
-    if (levels[d + 1] <= levels[d]) fail("levelOffsets[" + std::to_string(d + 1) + "] does not increase");
-    std::uint64_t split = 0;
-    for (std::uint32_t i = levels[d]; i < levels[d + 1]; ++i) split += (interiorBits[i >> 6] >> (i & 63)) & 1u;
-    const std::uint64_t nextLevelSize = d + 2 < levels.size() ? levels[d + 2] - levels[d + 1] : 0;
-    if (8 * split != nextLevelSize)
-      fail("level " + std::to_string(d + 1) + " has " + std::to_string(nextLevelSize) + " nodes but level " + std::to_string(d) + " has " + std::to_string(split) + " interior nodes");
-  }
-  if (tree.lattice.size() != interior * kContactTreeLatticePerNode)
-    fail("lattice has " + std::to_string(tree.lattice.size()) + " values for " + std::to_string(interior) + " interior nodes");
-  for (std::size_t i = 0; i < tree.lattice.size(); ++i)
-    if (!std::isfinite(tree.lattice[i])) fail("lattice[" + std::to_string(i) + "] is not finite");
-  if (tree.halfSpaces.size() != surfaceCount)
-    fail("halfSpaces has " + std::to_string(tree.halfSpaces.size()) + " entries, the surface bitmap marks " + std::to_string(surfaceCount));
-  for (std::size_t i = 0; i < tree.halfSpaces.size(); ++i) {
-    const ContactHalfSpace& hs = tree.halfSpaces[i];
-    const double len = std::sqrt(double(hs.normal[0]) * hs.normal[0] + double(hs.normal[1]) * hs.normal[1] + double(hs.normal[2]) * hs.normal[2]);
-    if (!(std::abs(len - 1.0) < 1e-3) || !std::isfinite(hs.offset) || !(std::isfinite(hs.fitError) && hs.fitError >= 0.0f))
-      fail("halfSpaces[" + std::to_string(i) + "] is not a unit normal with finite offset and fit error");
-  }
+  if (decoded != n) fail("the coded stream holds " + std::to_string(decoded) + " nodes, the header declares " + std::to_string(n));
+  if (tree.depthCount() != depths) fail("the coded stream holds " + std::to_string(tree.depthCount()) + " depths, the header declares " + std::to_string(depths));
+  if (dec.consumed() != coded.size()) fail(std::to_string(coded.size() - dec.consumed()) + " unused bytes at the end of the coded stream");
+  tree.assignNodeBits(interiorFlags, surfaceFlags);
   tree.buildLookupGrid();
   tree.deriveFlatSurfaces();
   return tree;

@@ -223,13 +223,18 @@ TEST_F(BakeContactTree, TrailingOrMissingPayloadBytesAndNewerVersionsAreRejected
   std::vector<std::byte> innerNewer = payload;
   innerNewer[0] = std::byte{kContactTreeCodecVersion + 1};  // the codec's own u32 version, little-endian
   EXPECT_EQ(thrownCode([&] { decodeBake(fileWithTreePayload(baked_->contents, innerNewer)); }), ErrorCode::kBakeVersion);
-  // A file from before the bitmap encoding (codec version 1: 32-bit child indices) must not be
-  // misread as the current layout: it is refused by version, with a message saying so.
-  std::vector<std::byte> innerOld = payload;
-  innerOld[0] = std::byte{1};
-  const std::vector<std::byte> oldFile = fileWithTreePayload(baked_->contents, innerOld);
-  EXPECT_EQ(thrownCode([&] { decodeBake(oldFile); }), ErrorCode::kBakeVersion);
-  EXPECT_NE(thrownMessage(oldFile).find("version 1 is not the supported version 2"), std::string::npos) << thrownMessage(oldFile);
+  // Files from before the compact encoding (codec version 2: float arrays; version 1: 32-bit
+  // child indices) must not be misread as the current layout: they are refused by version,
+  // with a message saying so and asking for a re-bake.
+  for (std::uint8_t old : {std::uint8_t{1}, std::uint8_t{2}}) {
+    std::vector<std::byte> innerOld = payload;
+    innerOld[0] = std::byte{old};
+    const std::vector<std::byte> oldFile = fileWithTreePayload(baked_->contents, innerOld);
+    EXPECT_EQ(thrownCode([&] { decodeBake(oldFile); }), ErrorCode::kBakeVersion);
+    const std::string message = thrownMessage(oldFile);
+    EXPECT_NE(message.find("version " + std::to_string(old) + " is not the supported version 3"), std::string::npos) << message;
+    EXPECT_NE(message.find("re-bake"), std::string::npos) << message;
+  }
 }
 
 // Bytes flipped inside the payload with valid checksums (a hostile or buggy writer): every
@@ -242,9 +247,10 @@ TEST_F(BakeContactTree, ResealedPayloadFlipsAreRejectedOrGiveASafeTree) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   // Fields no valid variation of which exists for this mesh (codec layout, contact_tree_codec.h):
   // version [0,4), meshDiagonal [36,44) (tied to the mesh), maxDepth [60,64) (0x40 takes it
-  // past 20), levelOffsets' count [96,104) (the arrays no longer agree).
+  // past 20), node count, depth count and the coded stream's length [96,112) (no longer what
+  // the stream holds).
   auto mustReject = [](std::size_t at) {
-    return at < 4 || (at >= 36 && at < 44) || (at >= 60 && at < 64) || (at >= 96 && at < 104);
+    return at < 4 || (at >= 36 && at < 44) || (at >= 60 && at < 64) || (at >= 96 && at < 112);
   };
   for (std::size_t k = 0; k < samples; ++k) {
     // The first 100 bytes (header and array counts) one by one, then an even spread.

@@ -1,0 +1,162 @@
+// The compact contact-tree encoding (codec version 3, docs/bake-format.md): the decoded tree is
+// the built tree bit for bit, its field stays within eps_s of a brute-force distance over all
+// triangles, and the stored values are the exact distances rounded by at most half a step.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+
+#include <tbb/parallel_for.h>
+
+#include "clod/contact_tree_codec.h"
+#include "clod/error.h"
+#include "tree_cache.h"
+
+namespace clod {
+namespace {
+
+using test::sharedTree;
+
+ContactTree roundTrip(const ContactTree& tree, std::size_t* bytes = nullptr) {
+  ByteWriter writer;
+  encodeContactTree(tree, writer);
+  if (bytes) *bytes = writer.size();
+  ByteReader reader(writer.bytes().data(), writer.size(), "test");
+  ContactTree decoded = decodeContactTree(reader);
+  EXPECT_TRUE(reader.atEnd());
+  return decoded;
+}
+
+template <class T>
+bool sameBytes(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+// Unsigned distance from p to the mesh by visiting every triangle: independent of the BVH and
+// of the sign logic of MeshDistance, which built the tree.
+double bruteForceDistance(const TriangleMesh& mesh, const Vec3& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (std::uint32_t t = 0; t < mesh.triangleCount(); ++t)
+    best = std::min(best, closestPointOnTriangle(p, mesh.corner(t, 0), mesh.corner(t, 1), mesh.corner(t, 2)).distanceSquared);
+  return std::sqrt(best);
+}
+
+TEST(ContactTreeCompactCodec, DecodedTreeIsTheBuiltTreeBitForBit) {
+  const auto& built = sharedTree("spot.obj");
+  std::size_t bytes = 0;
+  const ContactTree decoded = roundTrip(built.tree, &bytes);
+  EXPECT_TRUE(sameBytes(decoded.levelOffsets, built.tree.levelOffsets));
+  EXPECT_TRUE(sameBytes(decoded.errorCode, built.tree.errorCode));
+  EXPECT_TRUE(sameBytes(decoded.lattice, built.tree.lattice));
+  EXPECT_TRUE(sameBytes(decoded.halfSpaces, built.tree.halfSpaces));
+  EXPECT_TRUE(sameBytes(decoded.nodeWords, built.tree.nodeWords));
+  EXPECT_TRUE(sameBytes(decoded.flatSurface, built.tree.flatSurface));
+  EXPECT_EQ(std::memcmp(decoded.rootCorners.data(), built.tree.rootCorners.data(), sizeof(decoded.rootCorners)), 0);
+  // What the arrays would take as plain floats (codec version 2: 2 bits + a 16-bit code per
+  // node, 19 floats per split node, 5 floats per half-space); the compact stream must be
+  // several times smaller, or the rounding and prediction are not doing their job.
+  const double plain = 2.25 * double(built.tree.nodeCount()) + 4.0 * double(built.tree.lattice.size()) + 20.0 * double(built.tree.halfSpaces.size());
+  RecordProperty("bytes", std::to_string(bytes));
+  RecordProperty("plainBytes", std::to_string(plain));
+  EXPECT_LT(double(bytes), plain / 4.0) << bytes << " bytes vs " << plain << " as floats";
+}
+
+TEST(ContactTreeCompactCodec, DecodedFieldIsWithinEpsOfBruteForceDistanceInTheBand) {
+  const auto& built = sharedTree("spot.obj");
+  const ContactTree decoded = roundTrip(built.tree);
+  const TriangleMesh& mesh = built.exact->mesh();
+  const auto prefix = test::areaPrefix(mesh);
+  const int count = test::sanitizerRun() ? 300 : 3000;
+  std::mt19937_64 rng(2026);
+  std::vector<Vec3> points(count);
+  for (Vec3& p : points) p = test::randomBandPoint(mesh, prefix, decoded.bandAbs, rng);
+  std::vector<double> reference(count);
+  tbb::parallel_for(0, count, [&](int i) { reference[i] = bruteForceDistance(mesh, points[i]); });
+  double maxError = 0.0;
+  for (int i = 0; i < count; ++i) {
+    // ||a| - |b|| <= |a - b|: the unsigned comparison is implied by the signed guarantee.
+    const double error = std::abs(std::abs(decoded.distance(points[i])) - reference[i]);
+    maxError = std::max(maxError, error);
+  }
+  RecordProperty("maxErrorRel", std::to_string(maxError / decoded.meshDiagonal));
+  // eps_s holds in the band by construction (measured with the stored, rounded values); float
+  // corners add at most 2^-23 of the diagonal (contact_tree_accuracy_test.cpp).
+  EXPECT_LE(maxError, decoded.errorAbs + std::ldexp(decoded.meshDiagonal, -23)) << maxError / decoded.meshDiagonal << " diag";
+}
+
+TEST(ContactTreeCompactCodec, StoredLatticeValuesAreTheExactDistanceWithinHalfAStep) {
+  const auto& built = sharedTree("spot.obj");
+  const ContactTree& tree = built.tree;
+  const double step = tree.valueStep();
+  ASSERT_GT(step, 0.0);
+  EXPECT_LE(step, tree.errorAbs / 8.0);
+  EXPECT_GT(step, tree.errorAbs / 16.0);
+  std::vector<ContactCell> stack{tree.rootCell()};
+  std::size_t checked = 0;
+  double worst = 0.0;
+  while (!stack.empty() && checked < 20'000) {
+    const ContactCell cell = stack.back();
+    stack.pop_back();
+    if (tree.isLeaf(cell.node)) continue;
+    for (std::uint32_t o = 0; o < 8; ++o) {
+      const ContactCell child = tree.childCell(cell, o);
+      // Every corner of the child but the one it shares with its parent (c == o) is one of the
+      // 19 values the parent stores.
+      for (std::uint32_t c = 0; c < 8; ++c) {
+        if (c == o) continue;
+        const Vec3 p = tree.cellMin(child) + tree.cellSize(child.depth) * Vec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+        const double exact = built.exact->signedDistance(p);
+        const double error = std::abs(child.corners[c] - exact);
+        worst = std::max(worst, error / step);
+        // Half a step of rounding plus the float rounding of the stored value.
+        EXPECT_LE(error, 0.5 * step + std::ldexp(std::abs(exact), -23)) << p.transpose();
+        ++checked;
+      }
+      stack.push_back(child);
+    }
+  }
+  RecordProperty("worstInSteps", std::to_string(worst));
+  EXPECT_GT(checked, 1000u);
+}
+
+TEST(ContactTreeCompactCodec, EncoderRefusesValuesItCannotStoreExactly) {
+  const auto& built = sharedTree("spot.obj");
+  auto refused = [](const ContactTree& tree) {
+    try {
+      ByteWriter writer;
+      encodeContactTree(tree, writer);
+    } catch (const Error& e) {
+      return e.code() == ErrorCode::kInvalidArgument;
+    }
+    return false;
+  };
+  ContactTree offGrid = built.tree;
+  offGrid.lattice[5] = std::nextafter(offGrid.lattice[5], 1e30f);  // not prediction + k steps
+  EXPECT_TRUE(refused(offGrid));
+  ContactTree tilted = built.tree;
+  ASSERT_FALSE(tilted.halfSpaces.empty());
+  tilted.halfSpaces[0].normal[0] = std::nextafter(tilted.halfSpaces[0].normal[0], 2.0f);  // no octahedral code
+  EXPECT_TRUE(refused(tilted));
+}
+
+TEST(ContactTreeCompactCodec, OlderVersionsAskForARebake) {
+  const auto& built = sharedTree("spot.obj");
+  ByteWriter writer;
+  encodeContactTree(built.tree, writer);
+  std::vector<std::byte> bytes = writer.bytes();
+  bytes[0] = std::byte{2};  // the codec's own u32 version, little-endian: the float-array layout
+  ByteReader reader(bytes.data(), bytes.size(), "old");
+  try {
+    (void)decodeContactTree(reader);
+    FAIL() << "a version-2 payload was decoded";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kBakeVersion);
+    EXPECT_NE(std::string(e.what()).find("re-bake"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace clod
