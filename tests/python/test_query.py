@@ -79,7 +79,10 @@ def test_overlapping_boxes_give_the_analytic_contact(box_bake, model):
     # cube at sdf_depth 5: about 0.035 m here).
     tol = 1e-9 * box_bake.diagonal + res.error_bound.max()
     rim = 0.035 if model == "contact-tree" else 0.0
-    np.testing.assert_allclose(res.normal[0], [0, 0, -1], atol=1e-9)
+    # The contact tree stores its distances on a grid of at most 1/8 of its error bound
+    # (docs/contact-tree.md), so a face's field gradient may tilt by a step over a cell: measured
+    # 1.7e-5 rad here (1e-3 of the diagonal / 8 over a 1/32 cell bounds it by ~1e-4).
+    np.testing.assert_allclose(res.normal[0], [0, 0, -1], atol=1e-4 if model == "contact-tree" else 1e-9)
     assert res.penetration_depth[0] == pytest.approx(0.05, abs=tol)
     assert np.all(res.penetration_depth <= 0.05 + tol)
     lo, hi = np.array([-0.2, -0.3, 0.45]), np.array([0.5, 0.5, 0.5])
