@@ -7,22 +7,15 @@
 #include <string>
 
 #include "clod/error.h"
+#include "generator_arguments.h"
 #include "clod/primitives.h"
 
 namespace clod {
 
 namespace {
 
-void requirePositive(double value, const std::string& name) {
-  if (!(value > 0.0) || !std::isfinite(value))
-    throw Error(ErrorCode::kInvalidArgument, name + " " + std::to_string(value) + " is not a positive finite number");
-}
-
-void requireCount(std::uint32_t value, std::uint32_t lo, std::uint32_t hi, const std::string& name) {
-  if (value < lo || value > hi)
-    throw Error(ErrorCode::kInvalidArgument, name + " " + std::to_string(value) + " not in [" + std::to_string(lo) +
-                                                 ", " + std::to_string(hi) + "]");
-}
+using detail::requireCount;
+using detail::requirePositive;
 
 // Two triangles of the planar quad a b c d (counter-clockwise seen from outside).
 void addQuad(TriangleMesh& mesh, std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d) {

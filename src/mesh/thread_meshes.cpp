@@ -7,21 +7,14 @@
 #include <string>
 
 #include "clod/error.h"
+#include "generator_arguments.h"
 
 namespace clod {
 
 namespace {
 
-void requirePositive(double value, const std::string& name) {
-  if (!(value > 0.0) || !std::isfinite(value))
-    throw Error(ErrorCode::kInvalidArgument, name + " " + std::to_string(value) + " is not a positive finite number");
-}
-
-void requireCount(std::uint32_t value, std::uint32_t lo, std::uint32_t hi, const std::string& name) {
-  if (value < lo || value > hi)
-    throw Error(ErrorCode::kInvalidArgument, name + " " + std::to_string(value) + " not in [" + std::to_string(lo) +
-                                                 ", " + std::to_string(hi) + "]");
-}
+using detail::requireCount;
+using detail::requirePositive;
 
 // One row of a helical surface: its axial phase within a pitch and its radius at angle theta.
 struct Row {
