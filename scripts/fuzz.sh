@@ -16,6 +16,10 @@ launcher=()
 if command -v ccache >/dev/null 2>&1; then
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
   export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$PWD}"
+  # The sanitizer and fuzz builds carry debug info (-g, -g1), for which ccache by default also
+  # hashes the build directory: every fresh clone missed the cache for them (a cold fuzz build
+  # is ~15 min on 2 cores). Their debug paths may then name the checkout that filled the cache.
+  export CCACHE_NOHASHDIR="${CCACHE_NOHASHDIR:-1}"
 fi
 # Only the layers the targets read with: no tests, CLI, engines or Python. -O1 as the sanitizer
 # build (cmake/ClodWarnings.cmake): faster to compile, what the sanitizers' documentation suggests.
