@@ -3,6 +3,7 @@
 // src/mesh (maps and sets, quadratic loops), and paths to the test data.
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <map>
@@ -11,7 +12,10 @@
 #include <utility>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "clod/mesh.h"
+#include "clod/mesh_validation.h"
 #include "support/test_scale.h"
 
 namespace clod::test {
@@ -52,6 +56,30 @@ inline std::uint32_t countComponentsByFloodFill(const TriangleMesh& mesh) {
     }
   }
   return components;
+}
+
+/// A generated part mesh checked by brute force: closed and consistently oriented (every
+/// undirected edge used by two triangles, every directed edge once), Euler characteristic
+/// 2 - 2 genus, no zero-area triangle, one component (flood fill and validateMesh), manifold,
+/// outward; returns the signed volume validateMesh reports.
+inline double expectClosedOrientedGenus(const TriangleMesh& mesh, int genus) {
+  const auto uses = countEdgeUses(mesh);
+  for (const auto& [edge, count] : uses) EXPECT_EQ(count, 2) << "edge " << edge.first << "-" << edge.second;
+  std::set<std::pair<std::uint32_t, std::uint32_t>> directed;
+  for (const Triangle& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) EXPECT_TRUE(directed.insert({t[k], t[(k + 1) % 3]}).second) << "directed edge used twice";
+  EXPECT_EQ(std::int64_t(mesh.vertexCount()) - std::int64_t(uses.size()) + std::int64_t(mesh.triangleCount()),
+            2 - 2 * genus);
+  for (std::uint32_t t = 0; t < mesh.triangleCount(); ++t) EXPECT_GT(mesh.triangleArea(t), 0.0) << "triangle " << t;
+  const MeshReport report = validateMesh(mesh);
+  EXPECT_TRUE(report.closed);
+  EXPECT_TRUE(report.consistentlyOriented);
+  EXPECT_EQ(report.components, 1u);
+  EXPECT_EQ(report.degenerateTriangles, 0u);
+  EXPECT_EQ(report.nonManifoldVertices, 0u);
+  EXPECT_EQ(countComponentsByFloodFill(mesh), 1u);
+  EXPECT_GT(report.signedVolume.value_or(0.0), 0.0);
+  return report.signedVolume.value_or(0.0);
 }
 
 }  // namespace clod::test

@@ -13,24 +13,7 @@
 namespace clod {
 namespace {
 
-// Closed and consistently oriented by brute force (every undirected edge used twice, every
-// directed edge once), Euler characteristic 2 - 2 genus, no degenerate triangle, positive
-// (outward) signed volume; returns that volume.
-double expectClosedOrientedGenus(const TriangleMesh& mesh, int genus) {
-  const auto uses = test::countEdgeUses(mesh);
-  for (const auto& [edge, count] : uses) EXPECT_EQ(count, 2) << "edge " << edge.first << "-" << edge.second;
-  std::set<std::pair<std::uint32_t, std::uint32_t>> directed;
-  for (const Triangle& t : mesh.triangles)
-    for (int k = 0; k < 3; ++k) EXPECT_TRUE(directed.insert({t[k], t[(k + 1) % 3]}).second) << "directed edge used twice";
-  EXPECT_EQ(std::int64_t(mesh.vertexCount()) - std::int64_t(uses.size()) + std::int64_t(mesh.triangleCount()),
-            2 - 2 * genus);
-  for (std::uint32_t t = 0; t < mesh.triangleCount(); ++t) EXPECT_GT(mesh.triangleArea(t), 0.0) << "triangle " << t;
-  const MeshReport report = validateMesh(mesh);
-  EXPECT_TRUE(report.closed);
-  EXPECT_TRUE(report.consistentlyOriented);
-  EXPECT_EQ(report.components, 1u);
-  return report.signedVolume.value_or(0.0);
-}
+using test::expectClosedOrientedGenus;
 
 TEST(PartMeshes, TorusVolumeIsThePrismSumExactly) {
   const double big = 0.03, small = 0.006;

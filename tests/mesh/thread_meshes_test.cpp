@@ -16,27 +16,7 @@
 namespace clod {
 namespace {
 
-// Closed, consistently oriented (brute force: every undirected edge used by two triangles, every
-// directed edge once), Euler characteristic 2 - 2 genus, no zero-area triangle, one component,
-// outward; returns the signed volume validateMesh reports.
-double expectClosedOrientedGenus(const TriangleMesh& mesh, int genus) {
-  const auto uses = test::countEdgeUses(mesh);
-  for (const auto& [edge, count] : uses) EXPECT_EQ(count, 2) << "edge " << edge.first << "-" << edge.second;
-  std::set<std::pair<std::uint32_t, std::uint32_t>> directed;
-  for (const Triangle& t : mesh.triangles)
-    for (int k = 0; k < 3; ++k) EXPECT_TRUE(directed.insert({t[k], t[(k + 1) % 3]}).second) << "directed edge used twice";
-  EXPECT_EQ(std::int64_t(mesh.vertexCount()) - std::int64_t(uses.size()) + std::int64_t(mesh.triangleCount()),
-            2 - 2 * genus);
-  const MeshReport report = validateMesh(mesh);
-  EXPECT_TRUE(report.closed);
-  EXPECT_TRUE(report.consistentlyOriented);
-  EXPECT_EQ(report.components, 1u);
-  EXPECT_EQ(report.degenerateTriangles, 0u);
-  EXPECT_EQ(report.nonManifoldVertices, 0u);
-  EXPECT_EQ(test::countComponentsByFloodFill(mesh), 1u);
-  EXPECT_GT(report.signedVolume.value_or(0.0), 0.0);
-  return report.signedVolume.value_or(0.0);
-}
+using test::expectClosedOrientedGenus;
 
 double radiusOf(const Vec3& v) { return std::hypot(v.x(), v.y()); }
 
