@@ -307,7 +307,14 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
         // face beside it. It would push sideways along a face that nothing presses on (the
         // stacked boxes' side faces); the cfm model drops such contacts too. (Not on an edge of
         // ours: two crossing edges touch at shallow depths with conflicting fields.)
-        if (conflict && surface.flat && -f.distance <= std::max(f.errorBound, treeO.errorAbs) + surface.residual) continue;
+        const bool grazing = -f.distance <= std::max(f.errorBound, treeO.errorAbs) + surface.residual;
+        if (conflict && surface.flat && grazing) continue;
+        // Within that error band the other field's direction is its rounding, not a surface: next
+        // to its edges the interpolated gradient leans toward the side face (a box sliding down a
+        // slope met a zero-depth contact under its front edge tilted 9 degrees back, tipped and
+        // lost 12 % of its travel). Our flat face is the one surface known there, so a grazing
+        // sample on it pushes along its normal.
+        if (surface.flat && grazing) normal = -normalWorldS;
         // Where our cell holds an edge, or the other field disagrees with our plane, two edges
         // may be crossing: if both fields show an edge around the sample, neither gradient
         // alone is the contact normal (each leans toward one of its faces), the common

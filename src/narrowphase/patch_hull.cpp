@@ -2,12 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
+
+#include <libqhull_r/qhull_ra.h>
 
 namespace clod::detail {
 namespace {
 
-constexpr std::size_t kHullDirections = 256;
+constexpr std::size_t kHullDirections = 1024;
 constexpr std::size_t kCheckDirections = 1024;
 
 // Spherical Fibonacci direction i of n (Keinert et al. 2015, eq. 2).
@@ -31,6 +35,46 @@ double support(const TriangleMesh& mesh, std::span<const std::uint32_t> ids, con
   return best;
 }
 
+// The vertices of the convex hull of `ids` (qhull; QJ joggles coplanar and cospherical input by
+// ~1e-11 of its size, so a vertex on a flat hull face may be left out: it is never more extreme
+// than the face's corners). False when qhull fails or the hull has more than maxVertices.
+bool hullVertices(const TriangleMesh& mesh, std::span<const std::uint32_t> ids, std::size_t maxVertices,
+                  std::vector<std::uint32_t>& out) {
+  if (ids.size() < 4) return false;
+  std::vector<coordT> coords(3 * ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    for (int a = 0; a < 3; ++a) coords[3 * i + a] = mesh.vertices[ids[i]][a];
+  // qhull reports errors on a FILE*: capture them in memory so the library never prints.
+  char* errorText = nullptr;
+  std::size_t errorSize = 0;
+  FILE* errorStream = open_memstream(&errorText, &errorSize);
+  if (errorStream == nullptr) return false;
+  qhT qhStorage;
+  qhT* qh = &qhStorage;
+  qh_zero(qh, errorStream);
+  char flags[] = "qhull QJ";
+  const int exitCode = qh_new_qhull(qh, 3, static_cast<int>(ids.size()), coords.data(), False, flags, nullptr, errorStream);
+  bool ok = exitCode == 0 && std::size_t(qh->num_vertices) <= maxVertices;
+  if (ok) {
+    out.clear();
+    vertexT* vertex;
+    FORALLvertices {
+      const int id = qh_pointid(qh, vertex->point);
+      if (id < 0 || std::size_t(id) >= ids.size()) {
+        ok = false;
+        break;
+      }
+      out.push_back(ids[std::size_t(id)]);
+    }
+  }
+  qh_freeqhull(qh, !qh_ALL);
+  int curlong = 0, totlong = 0;
+  qh_memfreeshort(qh, &curlong, &totlong);
+  std::fclose(errorStream);
+  std::free(errorText);
+  return ok;
+}
+
 }  // namespace
 
 double appendPatchSupportVertices(const TriangleMesh& mesh, std::span<const std::uint32_t> triangles,
@@ -45,21 +89,31 @@ double appendPatchSupportVertices(const TriangleMesh& mesh, std::span<const std:
     out.insert(out.end(), all.begin(), all.end());
     return 0.0;
   }
+  // The convex hull's vertices are the patch's support in every direction. A patch whose hull
+  // has too many (a finely tessellated convex body) keeps the extreme vertex of each of
+  // kHullDirections directions instead. (Extremes of 256 directions missed two of spot's four
+  // feet: dropped at 64 tests per frame it stood on one root-level contact and fell over.)
   std::vector<std::uint32_t> kept;
-  kept.reserve(kHullDirections);
-  for (std::size_t i = 0; i < kHullDirections; ++i) {
-    std::uint32_t arg = all.front();
-    support(mesh, all, fibonacciDirection(i, kHullDirections), &arg);
-    kept.push_back(arg);
+  const bool fromHull = hullVertices(mesh, all, kMaxHullSupportVertices, kept);
+  if (!fromHull) {
+    kept.clear();
+    kept.reserve(kHullDirections);
+    for (std::size_t i = 0; i < kHullDirections; ++i) {
+      std::uint32_t arg = all.front();
+      support(mesh, all, fibonacciDirection(i, kHullDirections), &arg);
+      kept.push_back(arg);
+    }
   }
   std::sort(kept.begin(), kept.end());
   kept.erase(std::unique(kept.begin(), kept.end()), kept.end());
-  // Slack: twice the largest shortfall over a 4x finer direction set. Measured, not proven:
-  // a support function is smooth between vertices' normal cones, and the finer set's spacing
-  // (~6 deg) is half the coarse set's (~13 deg) that makes the shortfall.
+  // Slack: twice the largest shortfall over a check direction set. For the hull it is only the
+  // joggle's (the check is a guard). For the directions' extremes it is measured, not proven: a
+  // support function is smooth between vertices' normal cones, and the 4x finer check set's
+  // spacing (~3.5 deg) is half the coarse set's (~7 deg) that makes the shortfall.
+  const std::size_t checks = fromHull ? kCheckDirections : 4 * kCheckDirections;
   double shortfall = 0.0;
-  for (std::size_t i = 0; i < kCheckDirections; ++i) {
-    const Vec3 n = fibonacciDirection(i, kCheckDirections);
+  for (std::size_t i = 0; i < checks; ++i) {
+    const Vec3 n = fibonacciDirection(i, checks);
     shortfall = std::max(shortfall, support(mesh, all, n, nullptr) - support(mesh, kept, n, nullptr));
   }
   out.insert(out.end(), kept.begin(), kept.end());

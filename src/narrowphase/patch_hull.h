@@ -15,12 +15,16 @@ namespace clod::detail {
 
 /// Patches of at most this many distinct vertices keep all of them (slack 0).
 inline constexpr std::size_t kMaxPatchSupportVertices = 64;
+/// Larger patches keep their convex hull's vertices if it has at most this many.
+inline constexpr std::size_t kMaxHullSupportVertices = 1024;
 
 /// Appends to `out` the support vertices (indices into mesh.vertices, ascending) of the patch made
 /// of `triangles` and returns the slack: the most by which max over them of n . v can fall short
-/// of the patch's support in any direction n. Small patches keep every vertex. Larger ones keep
-/// the extreme vertex of each of 256 spherical Fibonacci directions (an inner approximation of
-/// the convex hull); their slack is twice the largest shortfall measured over 1,024 directions.
+/// of the patch's support in any direction n. Small patches keep every vertex, larger ones their
+/// convex hull's vertices (qhull), and those whose hull has more than kMaxHullSupportVertices the
+/// extreme vertex of each of 1,024 spherical Fibonacci directions (an inner approximation of the
+/// hull). The slack is twice the largest shortfall measured over 1,024 directions (0 up to
+/// rounding and qhull's joggle for the hull).
 double appendPatchSupportVertices(const TriangleMesh& mesh, std::span<const std::uint32_t> triangles,
                                   std::vector<std::uint32_t>& out);
 
