@@ -9,7 +9,6 @@
 // and 240 Hz: plausible (never more than 1 % of the diagonal below the ground, no NaN, never
 // through it; oracle: the ground's top face and the mesh's own vertices). Not monotone: where a
 // landing mesh comes to rest depends on its bounces (docs/dynamics.md).
-// The contact tree is in the cut for plausibility and real time, not for monotonicity (below).
 // Under the sanitizers: the stack and the slide with cfm at 16 tests, 1 s; one drop, 1 s.
 #include <gtest/gtest.h>
 
@@ -73,10 +72,7 @@ TEST_P(Degradation, PlausibleAtEveryBudgetAndNeverWorseWithMore) {
     }
     errors.push_back(o.error);
   }
-  // Budgets in increasing order (unlimited last): each step up may not be worse. Not asserted for
-  // the contact tree: its slide and slopes stay plausible but are not monotone (2-20 mm more
-  // error at 256 tests than at 16; docs/dynamics.md, "Known limits").
-  if (cell.model == ContactModel::kContactTree) return;
+  // Budgets in increasing order (unlimited last): each step up may not be worse.
   for (std::size_t i = 0; i + 1 < errors.size(); ++i)
     EXPECT_TRUE(degradesMonotonically(errors[i], errors[i + 1]))
         << scenarioName(cell.kind) << " " << contactModelName(cell.model) << ": error " << errors[i] << " at budget "
