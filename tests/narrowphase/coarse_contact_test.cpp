@@ -354,4 +354,46 @@ TEST(CoarseContacts, CurvedMeshOnABoxRestsOnItsOwnVerticesWithTheirDepths) {
   EXPECT_GE(cases, 24);
 }
 
+
+// Two curved bodies at the roots (budget 1: the root pair is the whole frontier): wherever the
+// bodies' vertices, projected on the line through the root spheres' centres, do not overlap (a
+// separating axis, found by brute force over every vertex), cfm gives no contact, however much
+// the spheres overlap; wherever the exact model finds the surfaces crossing, cfm gives one. Before
+// two curved patches were bounded by their spheres alone, and cfm responded across the gap.
+TEST(CoarseContacts, CurvedPatchesApartAlongTheCentreLineGiveNoContact) {
+  static const CollisionBody bunny = test::makeTestBody(test::loadUnitMesh("bunny-1500.obj"), 2, false);
+  const SphereTree& tree = bunny.sphereTree();
+  const double rootRadius = tree.radius[0];
+  std::mt19937_64 rng(17);
+  int apart = 0, touching = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const Pose poseA = test::randomPose(rng, 0.0);
+    Pose poseB = test::randomPose(rng, 0.0);
+    // Root spheres overlapping by up to their radius.
+    std::uniform_real_distribution<double> gap(1.0, 2.0);
+    poseB.translation = poseA.apply(tree.center(0)) - poseB.rotation * tree.center(0) +
+                        gap(rng) * rootRadius * test::randomPose(rng, 1.0).translation.normalized();
+    const Vec3 cA = poseA.apply(tree.center(0)), cB = poseB.apply(tree.center(0));
+    const Vec3 u = (cA - cB).normalized();
+    double minA = std::numeric_limits<double>::infinity(), maxB = -minA;
+    for (const Vec3& v : bunny.mesh().vertices) {
+      minA = std::min(minA, u.dot(poseA.apply(v)));
+      maxB = std::max(maxB, u.dot(poseB.apply(v)));
+    }
+    const QueryResult cfm = queryContacts(bunny, poseA, bunny, poseB, settingsFor(ContactModel::kCfm, 1));
+    if (maxB < minA) {
+      ++apart;
+      EXPECT_TRUE(cfm.contacts.empty()) << "trial " << trial << ": apart by " << minA - maxB;
+    }
+    const QueryResult exact = queryContacts(bunny, poseA, bunny, poseB, settingsFor(ContactModel::kExact, kUnlimitedTests));
+    if (exact.colliding && !exact.contacts.empty()) {
+      ++touching;
+      EXPECT_FALSE(cfm.contacts.empty()) << "trial " << trial << ": the surfaces cross";
+    }
+  }
+  // Both kinds of pose occur often enough to mean something.
+  EXPECT_GE(apart, 20);
+  EXPECT_GE(touching, 20);
+}
+
 }  // namespace clod
