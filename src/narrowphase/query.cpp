@@ -834,6 +834,7 @@ bool vertexOnFaceContacts(const PatchSide& patch, const PatchSide& faceted, cons
   // rms off the exact track). Inside: behind every face of the whole body (the root's patch; the
   // leaf's faces if the root has too many).
   constexpr double kMinFacingCos = 0.5;  // cos 60 deg
+  constexpr double kMaxDetourRel = 0.02;
   const std::uint32_t root = 0;
   const bool whole = !faceted.body.sphereFaceNormals(root).empty();
   const PatchSide body{faceted.body, whole ? root : faceted.sphere, true, faceted.centre, faceted.radius, faceted.rotToA, faceted.shift};
@@ -859,9 +860,14 @@ bool vertexOnFaceContacts(const PatchSide& patch, const PatchSide& faceted, cons
       if (d < nearestDepth) nearestDepth = d, nearest = k;
     }
     if (!inside) continue;
-    // No face it faces, or one deeper than the patch is large (an open mesh's rim vertex, whose
-    // normal lies along the floor, faced the floor's side face 2 m away): the nearest face.
-    if (pressed == faces.size() || depth > patch.radius) pressed = nearest, depth = nearestDepth;
+    // No face it faces, or one much deeper than the nearest face: the nearest face. A vertex
+    // arrives at most a fraction of a percent of the smaller diagonal deep per substep (the
+    // world's arrival rule), so an exit kMaxDetourRel deeper than the nearest one is not where it
+    // came in: an open bunny's rim vertex, whose normal lies along the floor, faced the box's side
+    // face 0.3-2 m away, and the bunny was pushed sideways into the box (a drop ended 16 % of its
+    // diagonal inside).
+    const double detour = kMaxDetourRel * std::min(patch.body.diagonal(), faceted.body.diagonal());
+    if (pressed == faces.size() || depth > nearestDepth + detour) pressed = nearest, depth = nearestDepth;
     const Vec3& exit = halfSpaces[pressed].first;
     Contact ci = c;
     ci.normal = facetedIsB ? exit : Vec3(-exit);

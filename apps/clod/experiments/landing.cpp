@@ -173,12 +173,22 @@ DropStart drawDrop(std::mt19937_64& rng, const TriangleMesh& mesh, const Body& b
   return d;
 }
 
+// Signed distance of a point to the static box (2 x 2 x 0.5, centred at the origin): negative
+// inside. (The height above the top plane, used before, counted a body that rolled to the edge
+// and hung over it as "inside".)
+double signedDistanceToSlab(const Vec3& p) {
+  const Vec3 half(1.0, 1.0, kSlabTop);
+  const Vec3 q = p.cwiseAbs() - half;
+  const double outside = q.cwiseMax(0.0).norm();
+  return outside > 0.0 ? outside : q.maxCoeff();
+}
+
 struct DropRun {
   std::vector<Sample> samples;    // initial state first, then one per step
   std::vector<double> normalTilt; // per step: mean contact-normal angle from +z (deg); NaN: no contact
   double normalTiltSum = 0.0, normalTiltMax = 0.0;
   std::size_t normalCount = 0, contactSteps = 0;
-  double finalGap = 0.0;  // lowest vertex above the box top at the end (negative: below)
+  double finalGap = 0.0;  // smallest signed distance of a vertex to the box at the end (negative: inside)
 };
 
 DropRun runDrop(const Body& slab, const Body& body, const TriangleMesh& mesh, const DropStart& start,
@@ -223,8 +233,8 @@ DropRun runDrop(const Body& slab, const Body& body, const TriangleMesh& mesh, co
   const Sample& last = run.samples.back();
   bool first = true;
   for (const Vec3& v : mesh.vertices) {
-    const double z = last.com.z() + (last.q * (v - body.mass.centerOfMass)).z() - kSlabTop;
-    run.finalGap = first ? z : std::min(run.finalGap, z);
+    const double d = signedDistanceToSlab(last.com + last.q * (v - body.mass.centerOfMass));
+    run.finalGap = first ? d : std::min(run.finalGap, d);
     first = false;
   }
   return run;
