@@ -368,9 +368,13 @@ constexpr double kPoolNormalsCos = 0.5;
 // part's crest at 60, a box's side face crosses a top face at 90).
 constexpr double kFlatSpreadCos = 0.99984769515639;  // cos 1 deg
 constexpr double kConformalCos = 0.93969262078591;   // cos 20 deg
-// ... and one-sided when one inside piece has 10 x the other's area: a thread facet sunk 10 um
-// past the other part's crest has ~100 x the area of the crest strip inside it.
+// ... and one-sided when the faces cross at 45 deg or more and one inside piece has 10 x the
+// other's area: a thread facet sunk 10 um past the other part's crest (crossing at 60 deg) has
+// ~100 x the area of the crest strip inside it. Below 45 deg a sliver is tessellation luck: two
+// unit icospheres 0.1 deep cross at 36 deg, and their slivers tilted the resultant 6.3 deg off
+// the centre line (NarrowPhaseSpheres.EveryModelGivesTheCentreLine allows 6).
 constexpr double kDominantPiece = 10.0;
+constexpr double kOneSidedCrossingCos = 0.70710678118655;  // cos 45 deg
 // A local normal refines its patch's (c.normal on entry), which is the mean of the pieces' normals:
 // one more than 45 deg from it comes from an edge, not a surface (a face that an edge of the other
 // part cuts at a corner, whose inside piece is overestimated by clipping with the few triangles
@@ -1275,9 +1279,10 @@ std::uint32_t groupPatches(QueryScratch::Impl& s, double tol) {
 // volume gradient of its own triangle pair instead -- the area vectors of the pair's two inside
 // pieces, B's minus A's -- where that pair's surface is clear:
 //  * conformal: its two triangles face each other within kConformalCos (two flank facets);
-//  * one-sided: one piece is at least kDominantPiece times the other's area, i.e. one triangle is
-//    the surface and the other only grazes it with an edge (a flank facet sunk past the other
-//    part's crest, whose inside strip is as wide as the penetration).
+//  * one-sided: the faces cross at 45 deg or more (kOneSidedCrossingCos) and one piece is at
+//    least kDominantPiece times the other's area, i.e. one triangle is the surface and the other
+//    only grazes it with an edge (a flank facet sunk past the other part's crest, whose inside
+//    strip is as wide as the penetration).
 // Other pairs -- two faces crossing steeply with comparable pieces: two boxes' edges crossed, a
 // ball's intersection ring -- keep the patch's answer: there neither triangle is the contact's
 // surface, and their local gradients tilt apart where the patch's is right; so do contacts whose
@@ -1291,7 +1296,8 @@ void localNormal(const QueryScratch::Impl& s, std::uint32_t pair, Contact& c) {
   const auto& pa = s.pieceA[pair];
   const auto& pb = s.pieceB[pair];
   const bool conformal = s.pairNormalB[pair].dot(-s.pairNormalA[pair]) >= kConformalCos;
-  const bool oneSided = pa.area >= kDominantPiece * pb.area || pb.area >= kDominantPiece * pa.area;
+  const bool steep = s.pairNormalB[pair].dot(-s.pairNormalA[pair]) <= kOneSidedCrossingCos;
+  const bool oneSided = steep && (pa.area >= kDominantPiece * pb.area || pb.area >= kDominantPiece * pa.area);
   if (!conformal && !oneSided) return;
   const Vec3 n = pb.areaVector - pa.areaVector;
   const double len = n.norm();
