@@ -109,6 +109,7 @@ int runSimulate(const SimulateOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   bool barShown = false;
   for (std::uint32_t step = 1; step <= scene.steps; ++step) {
+    applyConstantTorques(scene, world);
     const auto stepStart = std::chrono::steady_clock::now();
     const StepReport& r = world.step(scene.dt);
     stepSeconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - stepStart).count());

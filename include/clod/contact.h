@@ -39,7 +39,7 @@ enum class ContactModel : std::uint8_t {
   /// sampling of the frontier cell pairs (contact_sampling.h), both ways round.
   kContactTree = 3,
   /// Polygon-level reference: triangle-triangle intersection of the leaves' triangles; one
-  /// normal and depth per connected contact patch (query.h).
+  /// normal and depth per connected contact patch, per point in a curved patch (query.h).
   kExact = 4,
 };
 

@@ -46,7 +46,12 @@
 // between the patch's two inside surfaces' centroids (docs/narrow-phase.md; where a face lies
 // wholly inside the other body, e.g. a box's bottom sunk into a slab, it crosses nothing and does
 // not count, and the depth is half the penetration). A flush coplanar patch gets its face normal
-// and depth 0. Patch grouping costs O(k log k) for k contact points. Pairs of the frontier that
+// and depth 0. In a curved patch (on both sides the inside pieces' normals spread by more than
+// 1 deg: a thread's helical band, not a box's face) a contact whose own triangle pair is
+// conformal (faces within 20 deg of facing each other) or one-sided (one inside piece >= 10x the
+// other's) takes that pair's own volume gradient as its normal instead, when within 45 deg of
+// the patch's (the depth stays the patch's): per-point normals, so a nut on a bolt's flank is pushed along the helix
+// (docs/narrow-phase.md). Patch grouping costs O(k log k) for k contact points. Pairs of the frontier that
 // did not get that far (interrupted before or during the triangle tests) give cfm contacts when
 // both bodies carry closest feature maps (no extra tests; pairs a separating axis proves apart
 // give none), else D&O contacts.

@@ -12,7 +12,9 @@
 // "frontier_pair_cost" (WorldSettings::frontierPairCost, 0..1024, default 2),
 // "bounds" {"min": [..], "max": [..]}, "bodies" [ ... ]. Body keys: "name", exactly one of
 // "mesh" (path relative to the scene file), "box" [hx,hy,hz] (half extents) or "sphere" r;
-// "position", "orientation" [w,x,y,z], "velocity", "angular_velocity", "density" or "mass"
+// "position", "orientation" [w,x,y,z], "velocity", "angular_velocity", "torque" [x,y,z] (N m,
+// world frame, constant: applyConstantTorques hands it to World::applyTorque before every step),
+// "density" or "mass"
 // (default density 1000; an open mesh gets the mass properties of its bounding box), "scale"
 // (uniform, mesh files only), "static", "kinematic", "restitution", "friction", "bake"
 // {"method": "octree"|"medial", "depth", "branching", "contact_tree_depth"}.
@@ -58,6 +60,7 @@ struct SceneBody {
   Quat orientation = Quat::Identity();
   Vec3 velocity = Vec3::Zero();
   Vec3 angularVelocity = Vec3::Zero();
+  Vec3 torque = Vec3::Zero();          ///< constant external torque, world frame (N m for SI scenes)
   SceneBakeOptions bake;
 };
 
@@ -90,5 +93,10 @@ struct SceneBuildReport {
 /// the baker, or World::addBody (messages name the body).
 World buildWorld(const SceneDescription& scene, const std::filesystem::path& cacheDir,
                  SceneBuildReport* report = nullptr);
+
+/// Applies every scene body's constant "torque" (SceneBody::torque, when not zero) to the world
+/// built from it by buildWorld (body i = scene body i) through World::applyTorque: call it before
+/// each World::step, which clears applied torques at its end. O(bodies).
+void applyConstantTorques(const SceneDescription& scene, World& world);
 
 }  // namespace clod

@@ -264,11 +264,20 @@ struct QueryScratch::Impl {
   std::vector<std::uint64_t> pairSet;  // open-addressing set of triangle-pair keys
   // Intersecting triangle pairs of the exact model: triangles, patch (after grouping).
   struct VolumePair {
-    std::uint32_t ta, tb, patch;
+    std::uint32_t ta, tb, patch, index;  // index: insertion order, kept through the sorts
   };
   std::vector<VolumePair> volumePairs;
   std::vector<std::uint8_t> pairCoplanar;  // per volume pair (insertion order)
+  std::vector<Vec3> pairNormalA;           // A's face normal per volume pair, A's frame
   std::vector<Vec3> pairNormalB;           // B's face normal per volume pair, A's frame
+  // Per volume pair (insertion order): the inside pieces of its A and of its B triangle (each
+  // triangle clipped by the other body's triangles it meets in the patch), A's frame.
+  struct Piece {
+    Vec3 areaVector, weightedCentroid;  // area x outward normal; area x centroid
+    double area;
+  };
+  std::vector<Piece> pieceA, pieceB;
+  std::vector<std::uint8_t> patchCurved;  // per patch: both sides' pieces spread (local normals)
   std::vector<std::uint32_t> patchParent;  // union-find over volume pairs
   struct CellPoint {
     std::array<std::int64_t, 3> cell;
@@ -281,6 +290,8 @@ struct QueryScratch::Impl {
     Vec3 centroidA, centroidB, fallbackNormal;
     double areaA, areaB;
     bool seen;
+    Vec3 vectorA, vectorB;      // sums of the pieces' area vectors, per side
+    double absoluteA, absoluteB;  // sums of their lengths
   };
   std::vector<PatchSums> patchSums;
   std::vector<std::uint32_t> clippers;
@@ -349,6 +360,26 @@ constexpr std::uint64_t kExactDirectPairs = 32;
 
 // cos 60 deg: the cone within which the manifold pools the normals of cfm contacts (below).
 constexpr double kPoolNormalsCos = 0.5;
+
+// Exact model, per-point normals (localNormal): a patch side whose pieces' area vectors
+// sum to less than cos 1 deg of their lengths' sum is curved (a flat face, however tessellated,
+// sums to its area: rounding only); a triangle pair is conformal when its faces are within 20 deg
+// of facing each other (a thread's flank facets meet within 8 deg; its flank crosses the other
+// part's crest at 60, a box's side face crosses a top face at 90).
+constexpr double kFlatSpreadCos = 0.99984769515639;  // cos 1 deg
+constexpr double kConformalCos = 0.93969262078591;   // cos 20 deg
+// ... and one-sided when the faces cross at 45 deg or more and one inside piece has 10 x the
+// other's area: a thread facet sunk 10 um past the other part's crest (crossing at 60 deg) has
+// ~100 x the area of the crest strip inside it. Below 45 deg a sliver is tessellation luck: two
+// unit icospheres 0.1 deep cross at 36 deg, and their slivers tilted the resultant 6.3 deg off
+// the centre line (NarrowPhaseSpheres.EveryModelGivesTheCentreLine allows 6).
+constexpr double kDominantPiece = 10.0;
+constexpr double kOneSidedCrossingCos = 0.70710678118655;  // cos 45 deg
+// A local normal refines its patch's (c.normal on entry), which is the mean of the pieces' normals:
+// one more than 45 deg from it comes from an edge, not a surface (a face that an edge of the other
+// part cuts at a corner, whose inside piece is overestimated by clipping with the few triangles
+// that edge meets: the nut's end step, normal along the helix, met by the bolt's crest edge).
+constexpr double kLocalConeCos = 0.70710678118655;  // cos 45 deg
 
 // A Pose as a rotation matrix: moving a point costs 9 multiply-adds instead of the quaternion's
 // two cross products. The traversal moves a centre per sphere test and the exact model three
@@ -1096,15 +1127,22 @@ Vec3 polygonAreaVector(const std::vector<Vec3>& poly) {
 // Normal and depth of every patch (s.patchNormal, s.patchDepth), each from its own pairs only:
 // a triangle is clipped by the half-spaces of the other body's triangles it meets in that patch.
 // A patch whose area vectors cancel keeps B's face normal of its first pair (B toward A).
+// Also keeps each pair's two pieces (s.pieceA, s.pieceB) and marks the curved patches
+// (s.patchCurved: on both sides the pieces' normals spread by more than kFlatSpreadCos), for the
+// per-point normals of exactContacts.
 void penetrationVolumeNormals(const TriangleMesh& ma, const TriangleMesh& mb, const Pose& xfAFromB,
                               std::uint32_t patchCount, QueryScratch::Impl& s) {
   auto& pairs = s.volumePairs;
   s.patchNormal.assign(patchCount, Vec3::Zero());
   s.patchDepth.assign(patchCount, 0.0);
+  s.patchCurved.assign(patchCount, 0);
+  s.pieceA.resize(pairs.size());
+  s.pieceB.resize(pairs.size());
   if (pairs.empty()) return;
   // patchNormal accumulates the area-vector sums.
   auto& sums = s.patchSums;
-  sums.assign(patchCount, {Vec3::Zero(), Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.0, false});
+  sums.assign(patchCount, {Vec3::Zero(), Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.0, false, Vec3::Zero(), Vec3::Zero(),
+                           0.0, 0.0});
   for (std::size_t i = 0; i < pairs.size(); ++i) {  // still in insertion order
     auto& q = sums[pairs[i].patch];
     if (!q.seen) q.fallbackNormal = s.pairNormalB[i];
@@ -1126,8 +1164,15 @@ void penetrationVolumeNormals(const TriangleMesh& ma, const TriangleMesh& mb, co
     const std::uint32_t t = pairs[i].ta;
     const std::uint32_t patch = pairs[i].patch;
     clipByHalfSpaces(ma.corner(t, 0), ma.corner(t, 1), ma.corner(t, 2), mb, aFromB, s.clippers, s.poly, s.polyTmp);
-    s.patchNormal[patch] -= polygonAreaVector(s.poly);  // its area vector is n_A * area (counter-clockwise)
-    accumulateCentroid(s.poly, identity, sums[patch].centroidA, sums[patch].areaA);
+    QueryScratch::Impl::Piece piece{polygonAreaVector(s.poly), Vec3::Zero(), 0.0};  // n_A * area (counter-clockwise)
+    accumulateCentroid(s.poly, identity, piece.weightedCentroid, piece.area);
+    auto& q = sums[patch];
+    s.patchNormal[patch] -= piece.areaVector;
+    q.centroidA += piece.weightedCentroid;
+    q.areaA += piece.area;
+    q.vectorA += piece.areaVector;
+    q.absoluteA += piece.areaVector.norm();
+    for (std::size_t k = i; k < j; ++k) s.pieceA[pairs[k].index] = piece;
     i = j;
   }
   // B's triangles, clipped by the A triangles they meet in the patch, in B's frame, then moved to A's.
@@ -1143,8 +1188,15 @@ void penetrationVolumeNormals(const TriangleMesh& ma, const TriangleMesh& mb, co
     const std::uint32_t t = pairs[i].tb;
     const std::uint32_t patch = pairs[i].patch;
     clipByHalfSpaces(mb.corner(t, 0), mb.corner(t, 1), mb.corner(t, 2), ma, bFromA, s.clippers, s.poly, s.polyTmp);
-    s.patchNormal[patch] += xfAFromB.rotation * polygonAreaVector(s.poly);
-    accumulateCentroid(s.poly, aFromB, sums[patch].centroidB, sums[patch].areaB);
+    QueryScratch::Impl::Piece piece{xfAFromB.rotation * polygonAreaVector(s.poly), Vec3::Zero(), 0.0};
+    accumulateCentroid(s.poly, aFromB, piece.weightedCentroid, piece.area);
+    auto& q = sums[patch];
+    s.patchNormal[patch] += piece.areaVector;
+    q.centroidB += piece.weightedCentroid;
+    q.areaB += piece.area;
+    q.vectorB += piece.areaVector;
+    q.absoluteB += piece.areaVector.norm();
+    for (std::size_t k = i; k < j; ++k) s.pieceB[pairs[k].index] = piece;
     i = j;
   }
   for (std::uint32_t p = 0; p < patchCount; ++p) {
@@ -1154,6 +1206,8 @@ void penetrationVolumeNormals(const TriangleMesh& ma, const TriangleMesh& mb, co
     if (q.areaA > 0.0 && q.areaB > 0.0) {
       s.patchDepth[p] = std::max(0.0, s.patchNormal[p].dot(q.centroidB / q.areaB - q.centroidA / q.areaA));
     }
+    s.patchCurved[p] =
+        q.vectorA.norm() < kFlatSpreadCos * q.absoluteA && q.vectorB.norm() < kFlatSpreadCos * q.absoluteB;
   }
 }
 
@@ -1241,6 +1295,39 @@ std::uint32_t groupPatches(QueryScratch::Impl& s, double tol) {
   return count;
 }
 
+// Per-point normals in a curved patch. A patch's one normal is the average of its surface's
+// normals over the patch; where the patch follows a curved surface for long (a nut's load flank is
+// one helical band: its average normal is the thread's axis, and the screw ratios of its contacts
+// spread over both signs, so a push along the flanks could not turn the nut), a contact takes the
+// volume gradient of its own triangle pair instead -- the area vectors of the pair's two inside
+// pieces, B's minus A's -- where that pair's surface is clear:
+//  * conformal: its two triangles face each other within kConformalCos (two flank facets);
+//  * one-sided: the faces cross at 45 deg or more (kOneSidedCrossingCos) and one piece is at
+//    least kDominantPiece times the other's area, i.e. one triangle is the surface and the other
+//    only grazes it with an edge (a flank facet sunk past the other part's crest, whose inside
+//    strip is as wide as the penetration).
+// Other pairs -- two faces crossing steeply with comparable pieces: two boxes' edges crossed, a
+// ball's intersection ring -- keep the patch's answer: there neither triangle is the contact's
+// surface, and their local gradients tilt apart where the patch's is right; so do contacts whose
+// local normal leaves a 45 deg cone about the patch's (kLocalConeCos). Only in curved
+// patches (both sides' pieces spread): a flat side -- a box's top face under anything -- keeps the
+// patch normal on every point. The depth stays the patch's: the pair's own pieces' centroid
+// distance along its normal is no penetration where one piece is a sliver (one-sided pairs), and
+// with it the depth-weighted resultant of bunny-on-bunny contacts drifted up to 23 deg from the
+// volume gradient (VolumeReference.ExactModelNormalFollowsTheVolumeGradientOnTheBunny).
+void localNormal(const QueryScratch::Impl& s, std::uint32_t pair, Contact& c) {
+  const auto& pa = s.pieceA[pair];
+  const auto& pb = s.pieceB[pair];
+  const bool conformal = s.pairNormalB[pair].dot(-s.pairNormalA[pair]) >= kConformalCos;
+  const bool steep = s.pairNormalB[pair].dot(-s.pairNormalA[pair]) <= kOneSidedCrossingCos;
+  const bool oneSided = steep && (pa.area >= kDominantPiece * pb.area || pb.area >= kDominantPiece * pa.area);
+  if (!conformal && !oneSided) return;
+  const Vec3 n = pb.areaVector - pa.areaVector;
+  const double len = n.norm();
+  if (!(len > 0.0) || n.dot(c.normal) < kLocalConeCos * len) return;
+  c.normal = n / len;
+}
+
 // Returns true if every frontier pair got its triangle tests.
 bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const Pose& xfAFromB,
                    const std::vector<SpherePair>& front, bool traversalFinished, Meter& meter,
@@ -1255,6 +1342,7 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
   s.exactContacts.clear();
   s.volumePairs.clear();
   s.pairCoplanar.clear();
+  s.pairNormalA.clear();
   s.pairNormalB.clear();
   hits.clear();
   bool complete = traversalFinished;
@@ -1312,8 +1400,9 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
         // faces), not pressed against each other: no contact.
         if (hit.coplanar && hit.normalA.dot(hit.normalB) > 0.0) continue;
         const auto pairIndex = static_cast<std::uint32_t>(s.volumePairs.size());
-        s.volumePairs.push_back({ref.ta, ref.tb, 0});
+        s.volumePairs.push_back({ref.ta, ref.tb, 0, pairIndex});
         s.pairCoplanar.push_back(hit.coplanar ? 1 : 0);
+        s.pairNormalA.push_back(hit.normalA);
         s.pairNormalB.push_back(hit.normalB);
         // Normal and depth are filled in below, once all intersecting pairs are known.
         const std::uint64_t key = (std::uint64_t{ref.ta} << 32) | ref.tb;
@@ -1346,6 +1435,7 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
     const std::uint32_t patch = s.patchParent[kc.pair];
     kc.contact.normal = s.patchNormal[patch];
     kc.contact.depth = s.patchDepth[patch];
+    if (s.patchCurved[patch] != 0) localNormal(s, kc.pair, kc.contact);
     out.push_back(kc.contact);
   }
   std::sort(hits.begin(), hits.end());

@@ -98,7 +98,7 @@ SceneBakeOptions parseBake(const Reader& r, const Json& j, const std::string& pa
 SceneBody parseBody(const Reader& r, const Json& j, const std::string& path, const std::filesystem::path& baseDir,
                     std::size_t index) {
   r.object(j, path, {"name", "mesh", "box", "sphere", "position", "orientation", "velocity", "angular_velocity",
-                     "density", "mass", "static", "kinematic", "restitution", "friction", "bake", "scale"});
+                     "torque", "density", "mass", "static", "kinematic", "restitution", "friction", "bake", "scale"});
   SceneBody b;
   b.name = j.contains("name") ? r.string(j["name"], path + ".name") : "body" + std::to_string(index);
   const int shapes = int(j.contains("mesh")) + int(j.contains("box")) + int(j.contains("sphere"));
@@ -125,6 +125,7 @@ SceneBody parseBody(const Reader& r, const Json& j, const std::string& path, con
   }
   if (j.contains("velocity")) b.velocity = r.vec<3>(j["velocity"], path + ".velocity");
   if (j.contains("angular_velocity")) b.angularVelocity = r.vec<3>(j["angular_velocity"], path + ".angular_velocity");
+  if (j.contains("torque")) b.torque = r.vec<3>(j["torque"], path + ".torque");
   if (j.contains("density") && j.contains("mass")) r.fail(path, "give \"density\" or \"mass\", not both");
   if (j.contains("density")) b.density = r.positive(j["density"], path + ".density");
   if (j.contains("mass")) b.mass = r.positive(j["mass"], path + ".mass");
@@ -345,6 +346,12 @@ World buildWorld(const SceneDescription& scene, const std::filesystem::path& cac
   }
   if (report) *report = rep;
   return world;
+}
+
+void applyConstantTorques(const SceneDescription& scene, World& world) {
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+    if (scene.bodies[i].torque != Vec3::Zero()) world.applyTorque(static_cast<BodyId>(i), scene.bodies[i].torque);
+  }
 }
 
 }  // namespace clod
