@@ -37,10 +37,12 @@ namespace clod {
 inline constexpr BakeSectionTag kBakeMeshTag = makeBakeSectionTag("MESH");
 inline constexpr std::uint32_t kBakeMeshVersion = 1;
 inline constexpr BakeSectionTag kBakeSphereTreeTag = makeBakeSectionTag("STRE");
-inline constexpr std::uint32_t kBakeSphereTreeVersion = 1;
+/// Version 2: quantised, range-coded (version 1, plain f64 arrays, is refused: re-bake).
+inline constexpr std::uint32_t kBakeSphereTreeVersion = 2;
 /// Closest feature maps of the sphere-tree (optional; layout in src/bake/cfm_section.h).
 inline constexpr BakeSectionTag kBakeCfmTag = makeBakeSectionTag("CFMP");
-inline constexpr std::uint32_t kBakeCfmVersion = 1;
+/// Version 2: range-coded (version 1, plain arrays, is refused: re-bake).
+inline constexpr std::uint32_t kBakeCfmVersion = 2;
 /// The contact tree of the mesh (optional; payload = encodeContactTree, contact_tree_codec.h;
 /// layout in src/bake/contact_tree_section.h and docs/bake-format.md).
 inline constexpr BakeSectionTag kBakeContactTreeTag = makeBakeSectionTag("CTRE");
