@@ -37,10 +37,12 @@ namespace clod {
 inline constexpr BakeSectionTag kBakeMeshTag = makeBakeSectionTag("MESH");
 inline constexpr std::uint32_t kBakeMeshVersion = 1;
 inline constexpr BakeSectionTag kBakeSphereTreeTag = makeBakeSectionTag("STRE");
-inline constexpr std::uint32_t kBakeSphereTreeVersion = 1;
+/// Version 2: quantised, range-coded (version 1, plain f64 arrays, is refused: re-bake).
+inline constexpr std::uint32_t kBakeSphereTreeVersion = 2;
 /// Closest feature maps of the sphere-tree (optional; layout in src/bake/cfm_section.h).
 inline constexpr BakeSectionTag kBakeCfmTag = makeBakeSectionTag("CFMP");
-inline constexpr std::uint32_t kBakeCfmVersion = 1;
+/// Version 2: range-coded (version 1, plain arrays, is refused: re-bake).
+inline constexpr std::uint32_t kBakeCfmVersion = 2;
 /// The contact tree of the mesh (optional; payload = encodeContactTree, contact_tree_codec.h;
 /// layout in src/bake/contact_tree_section.h and docs/bake-format.md).
 inline constexpr BakeSectionTag kBakeContactTreeTag = makeBakeSectionTag("CTRE");
@@ -64,7 +66,11 @@ struct BakeContents {
   /// Where the mesh came from (e.g. its file name), for humans; may be empty. ('MESH')
   std::string sourceName;
 
-  /// The sphere-tree and the settings it was built with. Required ('STRE').
+  /// The sphere-tree and the settings it was built with. Required ('STRE'). The file stores
+  /// sphere values on a power-of-two grid of at most 2^-11 of the parent's radius, radii rounded
+  /// up: a tree from elsewhere decodes with every ball containing its original and grown by
+  /// < 0.092 % of its parent's radius; a tree from bakeMesh or decodeBake is already on the grid
+  /// and survives bit for bit (docs/bake-format.md, 'STRE' version 2).
   SphereTree sphereTree;
   SphereTreeSettings sphereTreeSettings;
 
@@ -81,6 +87,7 @@ struct BakeContents {
 
 /// Encodes contents as a complete bake file. Deterministic: equal contents give identical
 /// bytes, and encodeBake(decodeBake(bytes)) == bytes for every file this function wrote.
+/// Lossless except for sphere values not yet on the file's grid (see BakeContents::sphereTree).
 /// O(size of the contents).
 ///
 /// Checks first that the contents can be decoded again and throws
@@ -160,7 +167,8 @@ struct BakeResult {
   ContactTreeBuildStats contactTreeStats;
 };
 
-/// Builds everything a bake holds for `mesh`: MeshDistance, then the sphere-tree, the closest
+/// Builds everything a bake holds for `mesh`: MeshDistance, then the sphere-tree (put on the
+/// file's grid at once, so what is built on it equals what a load returns), the closest
 /// feature maps and the contact tree (each of the last two unless switched off in settings). The mesh must be valid (see MeshDistance). Throws clod::Error from the
 /// builders: kInvalidArgument for out-of-range settings, mesh errors for invalid meshes.
 /// Uses TBB inside the builders.

@@ -71,13 +71,14 @@ BakeContents decodeBake(std::span<const std::byte> bytes) {
     contents.sourceName = std::move(mesh.sourceName);
   }
   {
-    detail::DecodedSphereTreeSection tree = detail::decodeSphereTreeSection(
-        file.section(kBakeSphereTreeTag, kBakeSphereTreeVersion).payload, contents.mesh.triangleCount());
+    const BakeSection section = file.section(kBakeSphereTreeTag, kBakeSphereTreeVersion);
+    detail::DecodedSphereTreeSection tree =
+        detail::decodeSphereTreeSection(section.payload, contents.mesh.triangleCount(), section.version);
     contents.sphereTree = std::move(tree.tree);
     contents.sphereTreeSettings = tree.settings;
   }
   if (const std::optional<BakeSection> cfm = file.findSection(kBakeCfmTag, kBakeCfmVersion)) {
-    contents.closestFeatureMap = detail::decodeCfmSection(cfm->payload, contents.sphereTree);
+    contents.closestFeatureMap = detail::decodeCfmSection(cfm->payload, contents.sphereTree, cfm->version);
   }
   if (const std::optional<BakeSection> tree = file.findSection(kBakeContactTreeTag, kBakeContactTreeVersion)) {
     contents.contactTree = detail::decodeContactTreeSection(tree->payload, contents.mesh);

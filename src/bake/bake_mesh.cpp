@@ -1,6 +1,7 @@
 #include <chrono>
 
 #include "clod/bake.h"
+#include "sphere_tree_section.h"
 
 namespace clod {
 
@@ -18,7 +19,9 @@ BakeResult bakeMesh(const TriangleMesh& mesh, const BakeSettings& settings) {
   result.signMethod = distance.signMethod();
 
   start = std::chrono::steady_clock::now();
-  result.contents.sphereTree = buildSphereTree(distance, settings.sphereTree);
+  // Put on the file's grid first, so the maps, the fit figures and the bake in memory are those
+  // of the tree a load returns (each sphere grows by < 0.1 % of its parent's radius).
+  result.contents.sphereTree = detail::quantisedSphereTree(buildSphereTree(distance, settings.sphereTree));
   result.timings.sphereTreeSeconds = secondsSince(start);
   if (settings.buildClosestFeatureMap) {
     start = std::chrono::steady_clock::now();
