@@ -344,8 +344,8 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
           // flush face too.
           if (grazing && flushAlong(treeS, xfWorldFromS, treeO, xfWorldFromO, pWorld, normal, rho, settings.maxDepth)) continue;
           if (edgeEdgeCount) ++*edgeEdgeCount;
-        } else if (grazing) {
-          continue;
+        } else if (grazing && settings.edgeEdgeNormals) {
+          continue;  // (with the edge-edge rule off, crossing edges keep their gradient contacts)
         } else if (conflict && surface.flat) {
           // The other body shows an edge or corner here while our cell is a flat face: an edge
           // or vertex on a face pushes along the face normal, not along the rounded field.
