@@ -59,10 +59,16 @@ struct Contact {
   Vec3 point = Vec3::Zero();    ///< the contact point
   Vec3 normal = Vec3::UnitZ();  ///< unit, from B toward A
   double depth = 0.0;           ///< penetration, > 0 when penetrating
-  /// How far the answer may be off, in length units: for sphere models the sum of the two
-  /// spheres' radii (the surfaces are somewhere inside both spheres, so depth and point are
-  /// uncertain by up to that much; it shrinks by the branching factor per level); for the
-  /// contact tree the field's error bound; 0 for exact contacts.
+  /// How far the depth may be off, in length units (>= 0). The promise, for a penetrating
+  /// contact (depth > 0): the penetration along the normal line through `point` -- how far the
+  /// point moves along -normal before it leaves A, plus how far along +normal before it leaves
+  /// B -- lies within depth +- errorBound. Values: for sphere models the sum of the two
+  /// spheres' radii (the surfaces are somewhere inside both spheres; it shrinks by the
+  /// branching factor per level), 0 where both sides are faceted patches of convex polyhedra
+  /// (clipped faces) or a vertex's exact depth below a convex body's face; for the contact tree
+  /// the field's error bound; 0 for exact contacts. Measured rates and where the promise does
+  /// not hold yet (exact's points on curved patches carry the patch's depth, not their own):
+  /// docs/narrow-phase.md, "Error bounds". No angle is promised for the normal.
   double errorBound = 0.0;
   /// Level of the pair the contact came from: for sphere-trees max(level of A's sphere, level
   /// of B's sphere), 0 = the roots; for contact trees the deeper cell's depth.

@@ -85,6 +85,24 @@ bool edgeEdgeNormal(const ContactTree& treeS, const Vec3& pS, const Pose& xfWorl
   return true;
 }
 
+// True when both bodies have a face through `pWorld` with outward normal +m or -m (the same
+// sign for both, within 10 degrees): coplanar faces facing the same way, i.e. flush. Probed one
+// probe radius rho out along +m and -m: outside both bodies there, both fields point along the
+// probe's direction.
+bool flushAlong(const ContactTree& treeS, const Pose& xfWorldFromS, const ContactTree& treeO, const Pose& xfWorldFromO,
+                const Vec3& pWorld, const Vec3& m, double rho, std::uint32_t maxDepth) {
+  constexpr double kSameWayCos = 0.98480775301220806;  // cos 10 deg
+  for (double sign : {1.0, -1.0}) {
+    const Vec3 q = pWorld + (sign * rho) * m;
+    const Vec3 gS = xfWorldFromS.rotation * treeS.sample(xfWorldFromS.applyInverse(q), maxDepth).gradient;
+    const Vec3 gO = xfWorldFromO.rotation * treeO.sample(xfWorldFromO.applyInverse(q), maxDepth).gradient;
+    if (gS.dot(sign * m) >= kSameWayCos * gS.norm() && gO.dot(sign * m) >= kSameWayCos * gO.norm() && gS.norm() > 1e-12 &&
+        gO.norm() > 1e-12)
+      return true;
+  }
+  return false;
+}
+
 // Where a sample of S lies on S's surface: S's outward normal there (S frame), whether the
 // surface is flat there (the half-space of the cell it lies in fits within kFlatFitRel of the
 // cell's size), that cell's size, and how far from the zero level the sample may lie.
@@ -302,19 +320,6 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
         if (!(gradientLength > 1e-12)) continue;  // flat interpolant: no direction to push
         Vec3 normal = xfWorldFromO.rotation * (f.gradient / gradientLength);
         const bool conflict = normal.dot(-normalWorldS) < conflictCos;
-        // A sample on a face of ours that only grazes the other body (depth within the field's
-        // error) where the other field turns away from the face: a flush side face seen from the
-        // face beside it. It would push sideways along a face that nothing presses on (the
-        // stacked boxes' side faces); the cfm model drops such contacts too. (Not on an edge of
-        // ours: two crossing edges touch at shallow depths with conflicting fields.)
-        const bool grazing = -f.distance <= std::max(f.errorBound, treeO.errorAbs) + surface.residual;
-        if (conflict && surface.flat && grazing) continue;
-        // Within that error band the other field's direction is its rounding, not a surface: next
-        // to its edges the interpolated gradient leans toward the side face (a box sliding down a
-        // slope met a zero-depth contact under its front edge tilted 9 degrees back, tipped and
-        // lost 12 % of its travel). Our flat face is the one surface known there, so a grazing
-        // sample on it pushes along its normal.
-        if (surface.flat && grazing) normal = -normalWorldS;
         // Where our cell holds an edge, or the other field disagrees with our plane, two edges
         // may be crossing: if both fields show an edge around the sample, neither gradient
         // alone is the contact normal (each leans toward one of its faces), the common
@@ -322,9 +327,32 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
         // edge's kink (the leaves there may lie on one side), so the probe radius is twice the
         // larger of the two cells.
         const double rho = 2.0 * std::max(surface.size, treeO.cellSize(f.depth));
+        // A sample that only grazes the other body (depth within the field's error) where the
+        // other field turns away from our surface: a flush side face seen from the face or the
+        // edge beside it (a box on an equal box: the upper box's bottom edge lies in the lower
+        // box's side plane, and the lower field there points out of that side). It would push
+        // sideways along a face that nothing presses on; the cfm model drops such contacts
+        // too. Two crossing edges also touch at shallow depths with conflicting fields, so the
+        // drop comes after the edge-edge rule has had its say (on our edge).
+        const bool shallow = -f.distance <= std::max(f.errorBound, treeO.errorAbs) + surface.residual;
+        const bool grazing = conflict && shallow;
+        if (grazing && surface.flat) continue;
+        // Within that error band the other field's direction is its rounding, not a surface: next
+        // to its edges the interpolated gradient leans toward the side face, if less than the
+        // conflict angle (a box sliding down a slope met a zero-depth contact under its front edge
+        // tilted 9 degrees back, tipped and lost 12 % of its travel). Our flat face is the one
+        // surface known there, so a shallow sample on it pushes along its normal.
+        if (shallow && surface.flat) normal = -normalWorldS;
         if (settings.edgeEdgeNormals && (conflict || !surface.flat) &&
             edgeEdgeNormal(treeS, pS, xfWorldFromS, rho, treeO, pO, xfWorldFromO, rho, settings.maxDepth, normal)) {
+          // Two edges that cross inside a plane both bodies have a face in (the upper box's
+          // top edge and the lower box's vertical edge, both in their flush side plane) have
+          // that plane's normal as their common perpendicular: a grazing sample there is a
+          // flush face too.
+          if (grazing && flushAlong(treeS, xfWorldFromS, treeO, xfWorldFromO, pWorld, normal, rho, settings.maxDepth)) continue;
           if (edgeEdgeCount) ++*edgeEdgeCount;
+        } else if (grazing && settings.edgeEdgeNormals) {
+          continue;  // (with the edge-edge rule off, crossing edges keep their gradient contacts)
         } else if (conflict && surface.flat) {
           // The other body shows an edge or corner here while our cell is a flat face: an edge
           // or vertex on a face pushes along the face normal, not along the rounded field.

@@ -816,19 +816,51 @@ bool facingFace(const PatchSide& side, const Vec3& toward, detail::FacePlane& pl
   return true;
 }
 
+// The supporting edge of a whole convex body along `toward` (A frame), for a side with no face
+// turned that way (an edge on a face, two parallel edges): the body's vertices at its support
+// height (within 1e-7 diagonals, as facingFace), as a "face" seen edge-on whose plane is
+// perpendicular to `toward` through them. Only for a patch that is the whole convex body: there
+// the vertices at the support height span the body's own supporting feature, so the segment
+// lies on its surface and every point of it has that height (a sub-patch's extreme vertices may
+// span a chord through the inside). False unless that feature has two or more vertices.
+bool supportingEdge(const PatchSide& side, const Vec3& toward, detail::FacePlane& plane, std::array<Vec3, 32>& corners,
+                    std::size_t& cornerCount) {
+  if (!side.body.patchIsWholeConvexBody(side.sphere)) return false;
+  std::span<const std::uint32_t> ids = side.body.spherePatchVertices(side.sphere);
+  const TriangleMesh& mesh = side.body.mesh();
+  std::array<Vec3, 32> placed;
+  plane.normal = toward;
+  plane.offset = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < ids.size() && i < placed.size(); ++i) {
+    placed[i] = side.toA(mesh.vertices[ids[i]]);
+    plane.offset = std::max(plane.offset, toward.dot(placed[i]));
+  }
+  const double tolerance = 1e-7 * side.body.diagonal();
+  cornerCount = 0;
+  for (std::size_t i = 0; i < ids.size() && i < placed.size(); ++i) {
+    if (toward.dot(placed[i]) >= plane.offset - tolerance) corners[cornerCount++] = placed[i];
+  }
+  return cornerCount >= 2;
+}
+
 // Contacts of two faceted patches along the chosen normal c.normal (A frame): where a face of
 // B faces A and a face of A faces B, the corners of the faces' overlap (detail::faceOverlapPoints),
 // each with its own depth (capped, like the single contact's, by the spheres' D&O depth) and
 // the pair's error bound -- a support area instead of one point at its centre, so that friction
 // and tilt have a lever arm at every level (a box sliding on a root-level contact at its face
-// centre tipped over). Edge-on-face and edge-on-edge keep the single contact. Returns false when
-// it added nothing.
+// centre tipped over). Where a side is a whole convex body that turns an edge toward the other
+// (supportingEdge), the edge stands in for its face: an edge on a face gets the two ends of its
+// part over the face, two parallel edges the ends of their common part (one contact in the
+// middle of a box's edge let the box spin about the normal and roll along the edge). Crossing
+// edges and corners keep the single contact. Returns false when it added nothing.
 bool facedPatchContacts(const PatchSide& sideA, const PatchSide& sideB, const Contact& c, std::vector<Contact>& out) {
   detail::FacePlane planeA, planeB;
   std::array<Vec3, 32> cornersA, cornersB;
   std::size_t countA = 0, countB = 0;
-  if (!facingFace(sideB, c.normal, planeB, cornersB, countB)) return false;
-  if (!facingFace(sideA, -c.normal, planeA, cornersA, countA)) return false;
+  const bool faceB = facingFace(sideB, c.normal, planeB, cornersB, countB);
+  const bool faceA = facingFace(sideA, -c.normal, planeA, cornersA, countA);
+  if (!faceB && !supportingEdge(sideB, c.normal, planeB, cornersB, countB)) return false;
+  if (!faceA && !supportingEdge(sideA, -c.normal, planeA, cornersA, countA)) return false;
   std::array<detail::FacePoint, detail::kMaxFaceOverlapPoints> points;
   const std::size_t count = detail::faceOverlapPoints(c.normal, planeB, std::span<const Vec3>(cornersB.data(), countB),
                                                       planeA, std::span<const Vec3>(cornersA.data(), countA), points);
@@ -907,7 +939,11 @@ bool vertexOnFaceContacts(const PatchSide& patch, const PatchSide& faceted, cons
     ci.normal = facetedIsB ? exit : Vec3(-exit);
     ci.point = v + 0.5 * depth * exit;
     ci.depth = depth;
-    ci.errorBound = 0.0;
+    // Exact only against the whole body's faces: "behind every face plane of a leaf's patch" is
+    // no proof of being inside (an icosphere's leaf holds a few of its 320 faces; a vertex
+    // behind them may lie outside the body), so there the pair's bound stays (measured:
+    // tests/narrowphase/error_bound_test.cpp, docs/narrow-phase.md "Error bounds").
+    ci.errorBound = whole ? 0.0 : c.errorBound;
     out.push_back(ci);
   }
   return out.size() > before;
