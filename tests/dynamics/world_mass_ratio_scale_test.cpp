@@ -179,9 +179,11 @@ TEST(WorldMassRatio, BoxScenesFromOneMillimetreToOneHundredMetresRestStackAndSli
           }
           const double expected = 4.0 * side / (2.0 * mu * 9.81);
           const RigidBodyState s = world.state(id);
-          // Within 10 %: the slide lasts v / (mu g) = 0.37 sqrt(side) s, under one 60 Hz step at 1 mm
-          // (the step's discretisation is then a few per cent of the distance).
-          EXPECT_NEAR(s.position.x() + 3.0 * side, expected, 0.1 * expected) << what << " slide";
+          // Within 15 %: the slide lasts v / (mu g) = 0.37 sqrt(side) s, 12 ms at 1 mm -- about 6 of
+          // the step's 8 substeps -- and semi-implicit Euler takes each substep's friction off
+          // before it moves, which shortens a slide of n substeps by about 1 / (2 n), 9 % at 1 mm
+          // (measured 10.2 %) and under 1 % from 1 m up.
+          EXPECT_NEAR(s.position.x() + 3.0 * side, expected, 0.15 * expected) << what << " slide";
           EXPECT_LT(lowest, 0.01) << what << " slide: sank";
           EXPECT_LT(tiltDegrees(s.orientation), 1.0) << what << " slide";
           EXPECT_LT(s.velocity.norm() / side, 0.01) << what << " slide";
