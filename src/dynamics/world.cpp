@@ -188,6 +188,7 @@ struct World::Impl {
   // substep's contact graph and the pairs between different layers, bottom-up.
   void orderSupportLayers();
   std::vector<std::uint32_t> supportLayer, layerQueue, adjacencyStart, adjacency;
+  std::vector<std::uint8_t> carries;  // a body is the lower one of some pair between two layers
   std::vector<std::uint32_t> shockPairs;  // indices into solveOrder, by lower layer
   void persistContacts(PairState& p, const Body& a, const Body& b, double diag);
   bool keepFinerManifold(PairState& p, const Body& a, const Body& b, double drift);
@@ -935,8 +936,8 @@ void World::Impl::solve(double h) {
 // breadth-first over the pairs with contacts, so a body's layer is the fewest contacts between it
 // and something immovable; bodies that touch nothing immovable, directly or through others, get
 // none (kNoLayer) and their pairs no shock sweep (zero gravity, a pile in free fall). shockPairs
-// lists the pairs of solveOrder between two different layers, ordered by the lower one (stable,
-// so within a layer the solver's fixed order by body ids). O(bodies + pairs), no allocation once
+// lists the pairs of solveOrder between two different layers, ordered by the lower one, within a
+// layer in the solver's fixed order by body ids. O(bodies + pairs log pairs), no allocation once
 // the vectors have grown.
 void World::Impl::orderSupportLayers() {
   constexpr std::uint32_t kNoLayer = std::numeric_limits<std::uint32_t>::max();
@@ -971,16 +972,31 @@ void World::Impl::orderSupportLayers() {
       layerQueue.push_back(j);
     }
   }
+  // A body on an immovable one that carries nothing is solved by the iterations exactly as the
+  // sweep would solve it (the immovable side has no mass to share): such pairs are left out, so a
+  // single body resting or sliding on the ground is solved as before.
+  carries.assign(n, 0);
+  for (auto& [p, ids] : solveOrder) {
+    const std::uint32_t la = supportLayer[ids[0]], lb = supportLayer[ids[1]];
+    if (p->contacts.empty() || la == lb || la == kNoLayer || lb == kNoLayer) continue;
+    carries[la < lb ? ids[0] : ids[1]] = 1;
+  }
   shockPairs.clear();
   for (std::size_t k = 0; k < solveOrder.size(); ++k) {
     const auto& [p, ids] = solveOrder[k];
     const std::uint32_t la = supportLayer[ids[0]], lb = supportLayer[ids[1]];
-    if (!p->contacts.empty() && la != lb && la != kNoLayer && lb != kNoLayer) shockPairs.push_back(std::uint32_t(k));
+    if (p->contacts.empty() || la == lb || la == kNoLayer || lb == kNoLayer) continue;
+    if (std::min(la, lb) == 0 && !carries[la < lb ? ids[1] : ids[0]]) continue;
+    shockPairs.push_back(std::uint32_t(k));
   }
-  std::stable_sort(shockPairs.begin(), shockPairs.end(), [&](std::uint32_t l, std::uint32_t r) {
+  // By lower layer, then by the solver's order (a total order: std::sort, which unlike
+  // std::stable_sort needs no buffer, gives one result).
+  std::sort(shockPairs.begin(), shockPairs.end(), [&](std::uint32_t l, std::uint32_t r) {
     const auto& il = solveOrder[l].second;
     const auto& ir = solveOrder[r].second;
-    return std::min(supportLayer[il[0]], supportLayer[il[1]]) < std::min(supportLayer[ir[0]], supportLayer[ir[1]]);
+    const std::uint32_t ll = std::min(supportLayer[il[0]], supportLayer[il[1]]);
+    const std::uint32_t lr = std::min(supportLayer[ir[0]], supportLayer[ir[1]]);
+    return ll != lr ? ll < lr : l < r;
   });
   // Effective masses of the upper body alone along the normal and the tangents.
   for (std::uint32_t k : shockPairs) {
