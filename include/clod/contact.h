@@ -54,6 +54,27 @@ ContactModel parseContactModel(std::string_view name);
 /// Contact::featureA / featureB when the model does not say which feature a contact came from.
 inline constexpr std::uint32_t kNoContactFeature = 0xffffffffu;
 
+/// What Contact::featureA / featureB index (docs/narrow-phase.md, "Feature ids").
+enum class ContactFeature : std::uint8_t {
+  /// Not reported: featureA = featureB = kNoContactFeature (containment contacts, contacts built
+  /// by hand).
+  kNone = 0,
+  /// Triangle indices into the two bodies' meshes (CollisionBody::mesh()): the exact model's
+  /// triangle-triangle intersections; the contact point lies on both triangles.
+  kTriangle = 1,
+  /// Sphere indices into the two bodies' sphere-trees: dos, average and cfm, the exact model's
+  /// cfm fallback of an interrupted query and its separating-axis answer between two convex
+  /// polyhedra (the root spheres, 0 and 0: the whole bodies). The contact came from that sphere
+  /// pair: its point lies within both spheres grown by the contact's depth and error bound --
+  /// except cfm's exact face corners between convex polyhedra (error bound 0), which lie on the
+  /// bodies' faces the two patches face along, and those may reach beyond the spheres.
+  kSphere = 2,
+  /// Node indices into the two bodies' contact trees (ContactCell::node): the cell pair the
+  /// contact was sampled from. The sample may have slid along the surface out of its cell
+  /// (contact_sampling.h), so the cells say where it started, not where it ended.
+  kCell = 3,
+};
+
 /// One contact point between A and B (world frame).
 struct Contact {
   Vec3 point = Vec3::Zero();    ///< the contact point
@@ -74,14 +95,27 @@ struct Contact {
   /// of B's sphere), 0 = the roots; for contact trees the deeper cell's depth.
   std::uint32_t level = 0;
   /// The features of A and B the contact came from, for matching contacts across frames (what
-  /// Box2D's contact ids and Bullet's part/index pairs are for): triangle indices of the meshes
-  /// for exact contacts, sphere indices of the sphere-trees for the sphere models, node indices
-  /// of the contact trees for the contact tree. kNoContactFeature where the narrow phase does not
-  /// report them -- at present it sets none (query.h); the reported contact points of both bodies
-  /// are StepReport::contactPoints (world.h), and World::separation names the closest triangles.
+  /// Box2D's contact ids and Bullet's part/index pairs are for); `featureKind` says what they
+  /// index: triangles of the meshes for the exact model's triangle contacts, spheres of the
+  /// sphere-trees for the sphere models, nodes of the contact trees for the contact tree
+  /// (ContactFeature). kNoContactFeature with ContactFeature::kNone where the narrow phase does
+  /// not know them. World::separation names the closest triangles of two bodies apart.
   std::uint32_t featureA = kNoContactFeature;
   std::uint32_t featureB = kNoContactFeature;
+  ContactFeature featureKind = ContactFeature::kNone;
 };
+
+/// The contact's two points, one on each body (world frame): point -/+ depth / 2 along the
+/// normal, so (pointOnA - pointOnB) . normal = -depth. These are the points the world anchors in
+/// the bodies and holds apart (StepReport::contactPoints, world.h). Where the model's point is
+/// the middle of the penetration -- dos, average and cfm (D&O points, face-clipped corners), and
+/// the exact model's face corners between convex polyhedra -- they are the two surfaces' points
+/// (tested on a box in a box). The exact model's triangle contacts lie on the surfaces'
+/// intersection with the patch's depth, and the contact tree's samples lie on one of the two
+/// surfaces: there the pair is the same penetration centred on the reported point, up to depth / 2
+/// away from the surface points (docs/narrow-phase.md, "Feature ids and both points").
+inline Vec3 contactPointOnA(const Contact& c) { return c.point - 0.5 * c.depth * c.normal; }
+inline Vec3 contactPointOnB(const Contact& c) { return c.point + 0.5 * c.depth * c.normal; }
 
 /// How reduceManifold picks contacts.
 struct ManifoldSettings {

@@ -19,6 +19,9 @@
 //      by more than 1 % of the smaller diagonal, and every point's separation is measured from its
 //      anchors each substep (per-point depth; open points are speculative: the solve lets them
 //      approach by separation / h);
+//      then one shock-propagation sweep up the bodies' support layers (contact-graph distance to
+//      an immovable body), each layer's pairs solved with the lower body held fixed, so a heavy
+//      body cannot push a light one under it into the ground (docs/dynamics.md, "Mass ratios");
 //      restitution only above WorldSettings::restitutionThreshold; penetration removed by a
 //      separate pseudo-velocity solve (split impulses) that moves positions but never enters the
 //      velocities, so correction adds no kinetic energy; integration (semi-implicit Euler for

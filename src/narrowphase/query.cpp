@@ -985,6 +985,9 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
     c.depth = dos.depth;
     c.errorBound = rA + rB;
     c.level = std::max(bodyA.sphereLevel(p.a), bodyB.sphereLevel(p.b));
+    c.featureA = p.a;  // every contact below is a copy of c: the pair's spheres
+    c.featureB = p.b;
+    c.featureKind = ContactFeature::kSphere;
     if (model == ContactModel::kDos) {
       c.normal = dos.normal;
       out.push_back(c);
@@ -1096,6 +1099,8 @@ void convexPolyhedraContacts(const CollisionBody& bodyA, const CollisionBody& bo
   c.depth = std::numeric_limits<double>::infinity();
   c.errorBound = 0.0;
   c.level = 0;
+  c.featureA = c.featureB = 0;  // the root spheres: the whole bodies
+  c.featureKind = ContactFeature::kSphere;
   if (leastOverlapNormal(sideA, sideB, rotAFromB, Vec3::Zero(), Vec3::Zero(), c.normal) != PatchAxis::kChosen) return;
   if (!patchDepthAndPoint(sideA, sideB, c.normal, c)) return;
   if (!facedPatchContacts(sideA, sideB, c, out)) out.push_back(c);
@@ -1445,6 +1450,9 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
         Contact c;
         c.errorBound = 0.0;
         c.level = std::max(bodyA.sphereLevel(front[i].a), bodyB.sphereLevel(front[i].b));
+        c.featureA = ref.ta;
+        c.featureB = ref.tb;
+        c.featureKind = ContactFeature::kTriangle;
         for (std::uint32_t q = 0; q < hit.count; ++q) {
           c.point = hit.points[q];
           s.exactContacts.push_back({key, pairIndex, c});
@@ -1687,6 +1695,9 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
         ct.depth = cp.depth;
         ct.errorBound = cp.errorBound;
         ct.level = level;
+        ct.featureA = p.a.node;
+        ct.featureB = p.b.node;
+        ct.featureKind = ContactFeature::kCell;
         s.raw.push_back(ct);
       }
     }

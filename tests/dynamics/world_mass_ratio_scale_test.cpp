@@ -1,0 +1,195 @@
+// Physics across mass ratios and sizes (issue 21, point 3), against analytic rest positions and
+// sliding distances: a heavy box on a light one on the ground (and the other way round) stands at
+// ratios up to 1,000 : 1, and resting boxes, a 3-box stack and a sliding box behave alike from
+// 1 mm to 100 m, with every contact model at a small, a middle and an unlimited budget.
+// Thresholds are relative to the box size; each is justified where it is used.
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "clod/bake.h"
+#include "clod/collision_body.h"
+#include "clod/contact_tree_builder.h"
+#include "clod/primitives.h"
+#include "clod/proximity.h"
+#include "clod/world.h"
+#include "support/test_scale.h"
+
+namespace clod {
+namespace {
+
+using test::sanitizerRun;
+
+std::shared_ptr<const CollisionBody> bakeShape(const TriangleMesh& mesh) {
+  BakeSettings settings;
+  settings.sphereTree.method = SphereTreeMethod::kOctree;
+  settings.sphereTree.depth = 3;
+  settings.measureFit = false;
+  settings.buildContactTree = false;  // set below with maxDepth 6, as scenes bake boxes
+  BakeResult baked = bakeMesh(mesh, settings);
+  auto body = std::make_shared<CollisionBody>(CollisionBody::fromBake(baked.contents));
+  ContactTreeSettings ct;
+  ct.maxDepth = 6;
+  body->setContactTree(buildContactTree(MeshDistance(mesh), ct));
+  return body;
+}
+
+// A unit cube (side 1) and a slab of 4 x 4 x 0.5 cube sides; World::addBody(desc, scale) makes
+// every size from them, so each size runs the same geometry in other units.
+const std::shared_ptr<const CollisionBody>& unitCube() {
+  static const auto shape = bakeShape(makeBox(Vec3(0.5, 0.5, 0.5)));
+  return shape;
+}
+const std::shared_ptr<const CollisionBody>& unitSlab() {
+  static const auto shape = bakeShape(makeBox(Vec3(4.0, 2.0, 0.25)));
+  return shape;
+}
+
+// A solid cube of side `side` and mass `mass` at `centre` (mesh origin = centre of mass).
+RigidBodyDesc cubeAt(double side, double mass, const Vec3& centre) {
+  RigidBodyDesc d;
+  d.shape = unitCube();
+  d.mass = mass;
+  d.inertia = Mat3::Identity() * (mass * side * side / 6.0);  // m (a^2 + a^2) / 12
+  d.position = centre;
+  d.friction = 0.6;
+  return d;
+}
+
+// The slab scaled to `side`, top face at z = 0.
+World groundWorld(ContactModel model, std::uint64_t budget, double side) {
+  WorldSettings ws;
+  ws.model = model;
+  ws.budgetTests = budget;
+  ws.bounds = Aabb{Vec3::Constant(-1e3 * side), Vec3::Constant(1e3 * side)};
+  World world(ws);
+  RigidBodyDesc ground;
+  ground.shape = unitSlab();
+  ground.type = BodyType::kStatic;
+  ground.position = Vec3(0.0, 0.0, -0.25 * side);
+  ground.friction = 0.6;
+  world.addBody(ground, side);
+  return world;
+}
+
+double tiltDegrees(const Quat& q) {
+  const Vec3 up = q * Vec3::UnitZ();
+  return std::acos(std::clamp(up.z(), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+const std::vector<ContactModel>& models() {
+  static const std::vector<ContactModel> all{ContactModel::kCfm, ContactModel::kExact, ContactModel::kContactTree};
+  return all;
+}
+std::vector<std::uint64_t> budgets() {
+  // Under the sanitizers the smallest and the unlimited budget: the middle one takes the same
+  // code paths (an interrupted and a finished query).
+  if (sanitizerRun()) return {16, 0};
+  return {16, 256, 0};
+}
+
+// Box i of a stack of unit cubes on the ground at rest has its centre at z = i + 0.5 (analytic).
+// Checked every step, so a box that sinks and comes back up fails too: no box lower than 1 % of
+// its side below that height (issue 21's criterion), none more than 1 % beside its start (a
+// squeezed-out box moves sideways by its whole size), and at the end at rest and upright.
+void expectStackStands(World& world, const std::vector<BodyId>& ids, double side, int steps, const std::string& what) {
+  double lowest = 0.0, farthest = 0.0;  // in box sides
+  for (int s = 0; s < steps; ++s) {
+    world.step(1.0 / 60.0);
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+      const Vec3 p = world.state(ids[i]).position / side;
+      lowest = std::max(lowest, (double(i) + 0.5) - p.z());
+      farthest = std::max(farthest, std::hypot(p.x(), p.y()));
+    }
+  }
+  // Each contact may rest up to the slop inside (0.2 % of the smaller diagonal, 0.35 % of a side,
+  // WorldSettings::slopRel), so the box on top of n contacts n times that; 1 % per box holds it.
+  EXPECT_LT(lowest, 0.01 * double(ids.size())) << what << ": a box sank";
+  EXPECT_LT(farthest, 0.01) << what << ": a box moved sideways";
+  for (BodyId id : ids) {
+    const RigidBodyState s = world.state(id);
+    // At rest: slower than 1 % of a side per second (a box falling its own size reaches
+    // sqrt(2 g side), 4.4 sides per second at 1 m).
+    EXPECT_LT(s.velocity.norm() / side, 0.01) << what;
+    EXPECT_LT(tiltDegrees(s.orientation), 1.0) << what;
+  }
+}
+
+// A 1,000 kg box on a 1 kg box on the ground squeezed the light box out sideways (cfm, exact) or
+// pushed it through the ground (contact tree): projected Gauss-Seidel passes the heavy box's
+// weight down to the ground at a rate of M / (M + m) per iteration. Fixed by shock propagation
+// (docs/dynamics.md, "Mass ratios"); this fails without it at 100 : 1 and 1,000 : 1.
+TEST(WorldMassRatio, HeavyOnLightAndLightOnHeavyStacksStandWithEveryModelAndBudget) {
+  for (double ratio : {10.0, 100.0, 1000.0})
+    for (bool heavyOnTop : {true, false})
+      for (ContactModel model : models())
+        for (std::uint64_t budget : budgets()) {
+          if (sanitizerRun() && ratio != 1000.0) continue;
+          World world = groundWorld(model, budget, 1.0);
+          const double lower = heavyOnTop ? 1.0 : ratio, upper = heavyOnTop ? ratio : 1.0;
+          std::vector<BodyId> ids{world.addBody(cubeAt(1.0, lower, Vec3(0, 0, 0.5))),
+                                  world.addBody(cubeAt(1.0, upper, Vec3(0, 0, 1.5)))};
+          const std::string what = std::string(contactModelName(model)) + " budget " + std::to_string(budget) +
+                                   (heavyOnTop ? " heavy on top, " : " light on top, ") + std::to_string(int(ratio)) + ":1";
+          expectStackStands(world, ids, 1.0, 180, what);  // 3 s
+        }
+}
+
+// The same box scenes from 1 mm to 100 m, each made from the unit shapes by World::addBody's
+// scale. Under a uniform scale by s with g fixed, motions keep their shape when time scales by
+// sqrt(s) (Froude similarity): speeds by sqrt(s), so a slide at 2 sqrt(s) m/s stops after
+// v^2 / (2 mu g) = 0.408 s. Each scene runs 3 sqrt(max(s, 1)) simulated seconds (a 100 m box
+// sliding at 20 m/s stops after 4.1 s).
+TEST(WorldMassRatio, BoxScenesFromOneMillimetreToOneHundredMetresRestStackAndSlideAlike) {
+  for (double side : {0.001, 0.01, 1.0, 10.0, 100.0})
+    for (ContactModel model : models())
+      for (std::uint64_t budget : {std::uint64_t(16), std::uint64_t(0)}) {
+        if (sanitizerRun() && side != 0.001 && side != 100.0) continue;
+        const int steps = int(std::lround(180.0 * std::sqrt(std::max(side, 1.0))));
+        const double mass = 1000.0 * side * side * side;  // water density
+        const std::string what =
+            std::string(contactModelName(model)) + " budget " + std::to_string(budget) + " side " + std::to_string(side);
+        {  // a resting box
+          World world = groundWorld(model, budget, side);
+          expectStackStands(world, {world.addBody(cubeAt(side, mass, Vec3(0, 0, 0.5 * side)), side)}, side, steps,
+                            what + " rest");
+        }
+        {  // a stack of three
+          World world = groundWorld(model, budget, side);
+          std::vector<BodyId> ids;
+          for (int i = 0; i < 3; ++i) ids.push_back(world.addBody(cubeAt(side, mass, Vec3(0, 0, (i + 0.5) * side)), side));
+          expectStackStands(world, ids, side, steps, what + " stack");
+        }
+        {  // a slide from 2 sqrt(side) m/s
+          World world = groundWorld(model, budget, side);
+          RigidBodyDesc box = cubeAt(side, mass, Vec3(-3.0 * side, 0, 0.5 * side));
+          box.friction = 0.5;
+          box.velocity = Vec3(2.0 * std::sqrt(side), 0, 0);
+          // The ground's friction 0.6 mixes to sqrt(0.5 * 0.6); the analytic stop uses the mix.
+          const double mu = std::sqrt(0.5 * 0.6);
+          const BodyId id = world.addBody(box, side);
+          double lowest = 0.0;
+          for (int s = 0; s < steps; ++s) {
+            world.step(1.0 / 60.0);
+            lowest = std::max(lowest, 0.5 - world.state(id).position.z() / side);
+          }
+          const double expected = 4.0 * side / (2.0 * mu * 9.81);
+          const RigidBodyState s = world.state(id);
+          // Within 15 %: the slide lasts v / (mu g) = 0.37 sqrt(side) s, 12 ms at 1 mm -- about 6 of
+          // the step's 8 substeps -- and semi-implicit Euler takes each substep's friction off
+          // before it moves, which shortens a slide of n substeps by about 1 / (2 n), 9 % at 1 mm
+          // (measured 10.2 %) and under 1 % from 1 m up.
+          EXPECT_NEAR(s.position.x() + 3.0 * side, expected, 0.15 * expected) << what << " slide";
+          EXPECT_LT(lowest, 0.01) << what << " slide: sank";
+          EXPECT_LT(tiltDegrees(s.orientation), 1.0) << what << " slide";
+          EXPECT_LT(s.velocity.norm() / side, 0.01) << what << " slide";
+        }
+      }
+}
+
+}  // namespace
+}  // namespace clod
