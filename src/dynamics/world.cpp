@@ -194,7 +194,6 @@ struct World::Impl {
   void persistContacts(PairState& p, const Body& a, const Body& b, double diag);
   bool keepFinerManifold(PairState& p, const Body& a, const Body& b, double drift);
   bool reuseManifold(const PairState& p, const Body& a, const Body& b) const;
-  double arrivalTravel(const BodyPair& c, double dt) const;
   void carryValidContacts(PairState& p, const Body& a, const Body& b, double matchDistance, double drift);
   void reduceCarried(std::vector<SolverContact>& contacts, std::size_t keep);
   std::vector<double> spread;  // reduceCarried's farthest-point distances
@@ -594,33 +593,6 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
   const auto tIntegrate = Clock::now();
   integrate(h);
   report.integrateSeconds += since(tIntegrate);
-}
-
-// How far two bodies that may touch during a step of dt can travel toward each other (the
-// arrival rule, World::step). Bodies without contacts between them: the sum of their travels,
-// in any direction. Bodies in contact: how fast their contact points close along the contacts'
-// normals, plus the turn's travel (a turning body can swing another part of itself onto the
-// other, a tipping box's far edge). Sliding along the contacts brings nothing closer: a box
-// sliding down a slope at 5 m/s took 8 substeps for travel that was all tangential, and the
-// contact-tree model then cost 1.3 s of CPU per simulated second.
-double World::Impl::arrivalTravel(const BodyPair& c, double dt) const {
-  const Body& a = bodies[c[0]];
-  const Body& b = bodies[c[1]];
-  const auto it = pairs.find(pairKey(c[0], c[1]));
-  if (it == pairs.end() || it->second.contacts.empty()) return stepTravel[c[0]] + stepTravel[c[1]];
-  auto pointVelocity = [&](const Body& body, const Vec3& p) -> Vec3 {
-    if (body.type == BodyType::kStatic) return Vec3::Zero();
-    const Vec3 v = body.type == BodyType::kDynamic ? Vec3(body.v + settings.gravity * dt) : body.v;
-    return v + body.w.cross(p - body.x);
-  };
-  double closing = 0.0;
-  for (const SolverContact& cp : it->second.contacts) {
-    const Vec3 p = 0.5 * (a.x + a.q * cp.anchorA + b.x + b.q * cp.anchorB);
-    // The normal points from B toward A: A closes on B when their relative velocity opposes it.
-    closing = std::max(closing, -(pointVelocity(a, p) - pointVelocity(b, p)).dot(cp.c.normal));
-  }
-  const double turning = (a.w - b.w).norm() * 0.5 * std::max(a.localBox.diagonal(), b.localBox.diagonal());
-  return (closing + turning) * dt;
 }
 
 // Manifold reuse (docs/dynamics.md): true while B has moved in A's frame, since the pair's last
@@ -1126,7 +1098,7 @@ const StepReport& World::step(double dt) {
   for (const BodyPair& c : m.candidates) {
     maxTravel = std::max({maxTravel, m.stepTravel[c[0]], m.stepTravel[c[1]]});
     const double diag = std::min(m.bodies[c[0]].desc.shape->diagonal(), m.bodies[c[1]].desc.shape->diagonal());
-    arrivalSubsteps = std::max(arrivalSubsteps, m.arrivalTravel(c, dt) / (kArrivalTravelRel * diag));
+    arrivalSubsteps = std::max(arrivalSubsteps, (m.stepTravel[c[0]] + m.stepTravel[c[1]]) / (kArrivalTravelRel * diag));
   }
   std::uint32_t n = m.settings.minSubsteps;
   if (std::isfinite(minExtent) && maxTravel > 0.0) {
