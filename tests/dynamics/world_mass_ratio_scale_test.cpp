@@ -18,25 +18,14 @@
 #include "clod/proximity.h"
 #include "clod/world.h"
 #include "support/test_scale.h"
+#include "world_test_support.h"
 
 namespace clod {
 namespace {
 
 using test::sanitizerRun;
 
-std::shared_ptr<const CollisionBody> bakeShape(const TriangleMesh& mesh) {
-  BakeSettings settings;
-  settings.sphereTree.method = SphereTreeMethod::kOctree;
-  settings.sphereTree.depth = 3;
-  settings.measureFit = false;
-  settings.buildContactTree = false;  // set below with maxDepth 6, as scenes bake boxes
-  BakeResult baked = bakeMesh(mesh, settings);
-  auto body = std::make_shared<CollisionBody>(CollisionBody::fromBake(baked.contents));
-  ContactTreeSettings ct;
-  ct.maxDepth = 6;
-  body->setContactTree(buildContactTree(MeshDistance(mesh), ct));
-  return body;
-}
+std::shared_ptr<const CollisionBody> bakeShape(const TriangleMesh& mesh) { return test::bakeWorldShape(mesh); }
 
 // A unit cube (side 1) and a slab of 4 x 4 x 0.5 cube sides; World::addBody(desc, scale) makes
 // every size from them, so each size runs the same geometry in other units.
