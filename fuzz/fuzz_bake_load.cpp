@@ -42,9 +42,9 @@ const clod::BakeContents& referenceContents() {
   return contents;
 }
 
-std::vector<std::byte> sectionPayload(clod::BakeSectionTag tag) {
+std::vector<std::byte> sectionPayload(clod::BakeSectionTag tag, std::uint32_t version) {
   const std::vector<std::byte> file = clod::encodeBake(referenceContents());
-  const auto payload = clod::BakeFileReader(file).section(tag, 1).payload;
+  const auto payload = clod::BakeFileReader(file).section(tag, version).payload;
   return {payload.begin(), payload.end()};
 }
 
@@ -53,8 +53,8 @@ std::vector<std::byte> sectionPayload(clod::BakeSectionTag tag) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;
   const std::span<const std::byte> rest(reinterpret_cast<const std::byte*>(data + 1), size - 1);
-  static const std::vector<std::byte> meshPayload = sectionPayload(clod::kBakeMeshTag);
-  static const std::vector<std::byte> treePayload = sectionPayload(clod::kBakeSphereTreeTag);
+  static const std::vector<std::byte> meshPayload = sectionPayload(clod::kBakeMeshTag, clod::kBakeMeshVersion);
+  static const std::vector<std::byte> treePayload = sectionPayload(clod::kBakeSphereTreeTag, clod::kBakeSphereTreeVersion);
 
   std::vector<std::byte> file;
   switch (data[0] % 3) {
