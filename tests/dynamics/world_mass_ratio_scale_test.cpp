@@ -29,10 +29,7 @@ std::shared_ptr<const CollisionBody> bakeShape(const TriangleMesh& mesh) { retur
 
 // A unit cube (side 1) and a slab of 4 x 4 x 0.5 cube sides; World::addBody(desc, scale) makes
 // every size from them, so each size runs the same geometry in other units.
-const std::shared_ptr<const CollisionBody>& unitCube() {
-  static const auto shape = bakeShape(makeBox(Vec3(0.5, 0.5, 0.5)));
-  return shape;
-}
+const std::shared_ptr<const CollisionBody>& unitCube() { return test::unitWorldCube(); }
 const std::shared_ptr<const CollisionBody>& unitSlab() {
   static const auto shape = bakeShape(makeBox(Vec3(4.0, 2.0, 0.25)));
   return shape;

@@ -32,10 +32,7 @@ using test::sanitizerRun;
 
 std::shared_ptr<const CollisionBody> bakeShape(const TriangleMesh& mesh) { return test::bakeWorldShape(mesh); }
 
-const std::shared_ptr<const CollisionBody>& unitCube() {
-  static const auto shape = bakeShape(makeBox(Vec3(0.5, 0.5, 0.5)));
-  return shape;
-}
+const std::shared_ptr<const CollisionBody>& unitCube() { return test::unitWorldCube(); }
 
 RigidBodyDesc dynamicBox(const std::shared_ptr<const CollisionBody>& shape, const Vec3& halfExtents, double mass) {
   RigidBodyDesc d;

@@ -8,6 +8,7 @@
 #include "clod/bake.h"
 #include "clod/collision_body.h"
 #include "clod/contact_tree_builder.h"
+#include "clod/primitives.h"
 #include "clod/proximity.h"
 
 namespace clod::test {
@@ -24,6 +25,12 @@ inline std::shared_ptr<const CollisionBody> bakeWorldShape(const TriangleMesh& m
   ct.maxDepth = 6;
   body->setContactTree(buildContactTree(MeshDistance(mesh), ct));
   return body;
+}
+
+/// A unit cube (side 1) baked as above, once per test binary.
+inline const std::shared_ptr<const CollisionBody>& unitWorldCube() {
+  static const std::shared_ptr<const CollisionBody> shape = bakeWorldShape(makeBox(Vec3(0.5, 0.5, 0.5)));
+  return shape;
 }
 
 }  // namespace clod::test
