@@ -394,25 +394,29 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       // share >= 1 and share <= remaining, so the substep never spends more than its allowance.
       std::uint64_t share = evenShare;
       if (perCell > 0) {
+        // A cached front is an answer only where it is re-tested: an untested front pair keeps
+        // last query's status (query.h), so a moving body sampled through a front it could not
+        // re-test got the contacts of where it had been -- a spinning box on the bin's floor
+        // re-sampled a 129-pair front with one test per substep, got no contact and fell
+        // through. A pair therefore re-tests its whole front (T >= F) or starts from the roots,
+        // whose answer is coarser but current.
         std::uint64_t front = std::max<std::uint64_t>(1, p->cache.frontSize());
-        if (perCell * front + 1 > nominal) {
-          // Its front alone costs more than a substep's even share of the step: it could wait for
-          // its turn forever, so it coarsens, from the roots.
+        const std::uint64_t rootsCost = 1 + perCell;
+        // What it may take and still leave the roots' answer to every pair after it.
+        const std::uint64_t reserve = rootsCost * (left - 1);
+        const std::uint64_t mayTake = remaining > reserve ? remaining - reserve : 0;
+        const std::uint64_t retestFront = rootsCost * front;
+        if (front > 1 && (retestFront > nominal || retestFront > mayTake)) {
+          // Its front costs more than a substep's even share of the step (it could wait for its
+          // turn forever), or more than the pairs after it leave: it coarsens, from the roots.
           p->cache.clear();
           front = 1;
         }
-        if (perCell * front + 1 <= remaining) {
-          // A pair may go over its share to sample its front once (round robin evens it out),
-          // never over what the substep has left.
-          const std::uint64_t grant = std::max(share, perCell * front + 1);
-          const std::uint64_t withinFront = std::min(front, grant - perCell * front);  // T <= F
-          const std::uint64_t beyondFront = grant / (1 + perCell);                     // T > F
-          share = std::max(withinFront, beyondFront > front ? beyondFront : 0);
-        } else if (front > 1 && !blind) {  // not affordable now
-          skip();
-          continue;
+        if (rootsCost * front <= remaining) {
+          // A pair may go over its share to re-test its front (round robin evens it out).
+          const std::uint64_t grant = std::max(share, rootsCost * front);
+          share = std::max(front, grant / rootsCost);  // T >= F, frontier <= T
         } else {
-          if (front > 1) p->cache.clear();  // a blind pair's roots' answer
           // Not even the roots' answer (1 test + perCell) is affordable: a budget of 1-2 tests
           // per frame at the default cost would never query a pair, and every dropped mesh fell
           // through the ground. The roots' answer is given for what the substep has left.
@@ -725,13 +729,26 @@ void World::Impl::reduceCarried(std::vector<SolverContact>& contacts, std::size_
 bool World::Impl::keepFinerManifold(PairState& p, const Body& a, const Body& b, double drift) {
   if (p.contacts.empty() || p.previous.empty()) return false;
   double newBound = std::numeric_limits<double>::infinity();
-  for (const SolverContact& cp : p.contacts) newBound = std::min(newBound, cp.c.errorBound);
+  double provenDepth = -std::numeric_limits<double>::infinity();  // the new answer's, at least
+  for (const SolverContact& cp : p.contacts) {
+    newBound = std::min(newBound, cp.c.errorBound);
+    provenDepth = std::max(provenDepth, cp.c.depth - cp.c.errorBound);
+  }
+  double heldDepth = -std::numeric_limits<double>::infinity();  // the previous one's, at most
   for (const SolverContact& old : p.previous) {
     if (!(old.c.errorBound < newBound)) return false;
     const Vec3 gap = a.x + a.q * old.anchorA - b.x - b.q * old.anchorB;
     const double open = gap.dot(old.c.normal);
     if (open >= drift || (gap - open * old.c.normal).norm() >= drift) return false;
+    heldDepth = std::max(heldDepth, -open + old.c.errorBound);
   }
+  // Anchors that still hold prove nothing when the solver is what holds them: a ball kept on a
+  // floor by a finer contact found at its side rolled about that point, its anchors never moved
+  // apart, and it sank 9 cm (a third of its diameter) into the floor through the coarse answers
+  // that said so. So the coarse answer refutes the finer manifold when it proves the bodies
+  // deeper (its depth less its bound) than the finer manifold allows (its deepest current
+  // separation plus bound) by more than the drift.
+  if (provenDepth > heldDepth + drift) return false;
   p.contacts.swap(p.previous);
   p.keptFiner = true;
   return true;
@@ -1148,7 +1165,6 @@ const StepReport& World::step(double dt) {
     // one such step cannot starve the next dozen (one 1 ms step made the estimate 8x too high).
     m.microsPerUnit = 0.75 * m.microsPerUnit + 0.25 * std::clamp(measured, 1e-6, 4.0 * m.microsPerUnit);
   }
-  if (std::getenv("CLOD_DEBUG_C")) { static int stepNo = 0; ++stepNo; for (auto& [k, ps] : m.pairs) for (auto& cp : ps.contacts) std::fprintf(stderr, "%d c p=(%.3f %.3f %.3f) n=(%.2f %.2f %.2f) d=%.4f eb=%.4f sep=%.4f lvl=%u\n", stepNo, cp.c.point.x(), cp.c.point.y(), cp.c.point.z(), cp.c.normal.x(), cp.c.normal.y(), cp.c.normal.z(), cp.c.depth, cp.c.errorBound, cp.separation, cp.c.level); }
   for (auto& [key, pr] : m.pairReports) {
     auto it = m.pairs.find(key);
     pr.contacts = it == m.pairs.end() ? 0 : std::uint32_t(it->second.contacts.size());
