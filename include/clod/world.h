@@ -238,6 +238,11 @@ struct StepReport {
   /// What the budget counted: testsSpent + WorldSettings::frontierPairCost x the frontier pairs of
   /// the charged models' queries (= testsSpent for dos and average); <= testsBudget when limited.
   std::uint64_t budgetSpent = 0;
+  /// The same count for all the work the queries did, charged or not: >= budgetSpent when a
+  /// query got more than its substep had left (the roots' answer to a pair that may be arriving,
+  /// under a time budget, or to any pair when not even that was left). A time budget converts to
+  /// units at timeSpentMicros / unitsWorked (exponential average over the steps).
+  std::uint64_t unitsWorked = 0;
   double timeBudgetMicros = 0.0;     ///< WorldSettings::budgetMicros (0 = no time limit)
   /// Narrow-phase time the time budget counted (WorldSettings::clock, µs, all substeps); 0 when
   /// there is no time limit.
