@@ -137,6 +137,52 @@ step("core consumer build (pkg-config)" ${LAUNCHER} ${CXX} -std=c++20 ${CONSUMER
 step("core consumer run (pkg-config)" ${WORK_DIR}/pc-core-consumer)
 check_consumer("core consumer (pkg-config)" "${step_output}")
 
+# The other components, configured only: each loads what it needs and no more, and finds only
+# its own packages (world: none of the I/O ones; io: Assimp but no JSON or glTF). An unknown
+# component is refused.
+set(probe_dir ${WORK_DIR}/component-probe)
+file(WRITE ${probe_dir}/CMakeLists.txt [=[
+cmake_minimum_required(VERSION 3.25)
+project(clod_component_probe LANGUAGES CXX)
+find_package(clod REQUIRED COMPONENTS ${PROBE_COMPONENT})
+foreach(target ${PROBE_PRESENT})
+  if(NOT TARGET clod::${target})
+    message(FATAL_ERROR "clod::${target} is missing")
+  endif()
+endforeach()
+foreach(target ${PROBE_ABSENT})
+  if(TARGET clod::${target})
+    message(FATAL_ERROR "clod::${target} was loaded, yet not asked for")
+  endif()
+endforeach()
+]=])
+function(probe_component name component present absent)
+  execute_process(COMMAND ${CMAKE_COMMAND} -S ${probe_dir} -B ${WORK_DIR}/probe-${name} -G ${GENERATOR}
+    -DCMAKE_CXX_COMPILER=${CXX} -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF
+    "-DPROBE_COMPONENT=${component}" "-DPROBE_PRESENT=${present}" "-DPROBE_ABSENT=${absent}" ${ARGN}
+    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  set(probe_rc ${rc} PARENT_SCOPE)
+  set(probe_output "${out}\n${err}" PARENT_SCOPE)
+endfunction()
+probe_component(world world "world;core" "io;scene;clod" ${no_io_packages})
+if(NOT probe_rc EQUAL 0)
+  message(FATAL_ERROR "find_package(clod COMPONENTS world) without the I/O packages:\n${probe_output}")
+endif()
+probe_component(io io "io;core" "world;scene;clod" -DCMAKE_DISABLE_FIND_PACKAGE_nlohmann_json=ON
+  -DCMAKE_DISABLE_FIND_PACKAGE_TinyGLTF=ON)
+if(NOT probe_rc EQUAL 0)
+  message(FATAL_ERROR "find_package(clod COMPONENTS io) without JSON and glTF:\n${probe_output}")
+endif()
+probe_component(scene scene "scene;world;io;core;clod" "")
+if(NOT probe_rc EQUAL 0)
+  message(FATAL_ERROR "find_package(clod COMPONENTS scene):\n${probe_output}")
+endif()
+probe_component(unknown "core;nope" "core" "")
+if(probe_rc EQUAL 0)
+  message(FATAL_ERROR "find_package(clod REQUIRED COMPONENTS core nope) configured")
+endif()
+message(STATUS "components: world, io and scene load what they need; an unknown one is refused")
+
 # 4. The Bullet plug-in, when this build has it: find_package(clod COMPONENTS bullet).
 file(GLOB_RECURSE bullet_targets ${prefix}/*/clodBulletTargets.cmake)
 if(bullet_targets)
