@@ -16,9 +16,14 @@ ValueError); files clod.FileError (also an OSError). docs/python.md describes th
 """
 
 from ._clod import (  # noqa: F401  (re-exported)
+    CONTACT_FEATURE_CELL,
+    CONTACT_FEATURE_NONE,
+    CONTACT_FEATURE_SPHERE,
+    CONTACT_FEATURE_TRIANGLE,
     FEATURE_EDGE,
     FEATURE_FACE,
     FEATURE_VERTEX,
+    NO_CONTACT_FEATURE,
     Bake,
     BatchQueryResult,
     ClosestResult,
@@ -43,6 +48,10 @@ from . import batch  # noqa: F401
 __all__ = [
     "Bake",
     "BatchQueryResult",
+    "CONTACT_FEATURE_CELL",
+    "CONTACT_FEATURE_NONE",
+    "CONTACT_FEATURE_SPHERE",
+    "CONTACT_FEATURE_TRIANGLE",
     "ClosestResult",
     "Error",
     "FEATURE_EDGE",
@@ -51,6 +60,7 @@ __all__ = [
     "FileError",
     "InvalidArgumentError",
     "Mesh",
+    "NO_CONTACT_FEATURE",
     "QueryResult",
     "StepReport",
     "World",

@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include "bindings.h"
+#include "clod/contact.h"
 #include "clod/degradation.h"
 #include "clod/mass_properties.h"
 #include "clod/query.h"
@@ -60,6 +61,7 @@ std::optional<double> deadlineMicros(std::optional<double> deadlineUs) {
 /// A query's answer as arrays (clod.QueryResult).
 struct PyQueryResult {
   py::array pos, normal, penetrationDepth, level, errorBound;
+  py::array featureKind, featureA, featureB, pointOnA, pointOnB;
   std::uint64_t budgetUsed = 0, sphereTests = 0, triangleTests = 0, rawContacts = 0, fallbackPairs = 0, frontierPairs = 0;
   bool finished = false, colliding = false;
   std::string stop, model;
@@ -67,23 +69,52 @@ struct PyQueryResult {
   double seconds = 0.0;
 };
 
-/// Contact arrays of contacts[begin, end) of each result, concatenated.
+/// Contact arrays of contacts[begin, end) of each result, concatenated: one array per field of
+/// clod::Contact, plus contactPointOnA / contactPointOnB (contact.h).
 struct ContactArrays {
-  py::array_t<double> pos, normal, depth, errorBound;
-  py::array_t<std::uint32_t> level;
+  py::array_t<double> pos, normal, depth, errorBound, pointOnA, pointOnB;
+  py::array_t<std::uint32_t> level, featureA, featureB;
+  py::array_t<std::uint8_t> featureKind;
   explicit ContactArrays(std::size_t n)
       : pos({py::ssize_t(n), py::ssize_t(3)}), normal({py::ssize_t(n), py::ssize_t(3)}), depth(py::ssize_t(n)),
-        errorBound(py::ssize_t(n)), level(py::ssize_t(n)) {}
+        errorBound(py::ssize_t(n)), pointOnA({py::ssize_t(n), py::ssize_t(3)}), pointOnB({py::ssize_t(n), py::ssize_t(3)}),
+        level(py::ssize_t(n)), featureA(py::ssize_t(n)), featureB(py::ssize_t(n)), featureKind(py::ssize_t(n)) {}
   void set(std::size_t i, const Contact& c) {
+    const Vec3 onA = contactPointOnA(c), onB = contactPointOnB(c);
     for (int k = 0; k < 3; ++k) {
       pos.mutable_data()[3 * i + k] = c.point[k];
       normal.mutable_data()[3 * i + k] = c.normal[k];
+      pointOnA.mutable_data()[3 * i + k] = onA[k];
+      pointOnB.mutable_data()[3 * i + k] = onB[k];
     }
     depth.mutable_data()[i] = c.depth;
     errorBound.mutable_data()[i] = c.errorBound;
     level.mutable_data()[i] = c.level;
+    featureKind.mutable_data()[i] = static_cast<std::uint8_t>(c.featureKind);
+    featureA.mutable_data()[i] = c.featureA;
+    featureB.mutable_data()[i] = c.featureB;
+  }
+  /// The feature and two-point arrays as a dict (StepReport.contact_features, the callback's).
+  py::dict features() const {
+    py::dict out;
+    out["feature_kind"] = featureKind;
+    out["feature_a"] = featureA;
+    out["feature_b"] = featureB;
+    out["point_on_a"] = pointOnA;
+    out["point_on_b"] = pointOnB;
+    return out;
   }
 };
+
+/// Copies the feature and two-point arrays into a result struct with those five members.
+template <typename Result>
+void putContactFeatures(const ContactArrays& arrays, Result& out) {
+  out.featureKind = arrays.featureKind;
+  out.featureA = arrays.featureA;
+  out.featureB = arrays.featureB;
+  out.pointOnA = arrays.pointOnA;
+  out.pointOnB = arrays.pointOnB;
+}
 
 PyQueryResult packQueryResult(const QueryResult& r, ContactModel model) {
   ContactArrays arrays(r.contacts.size());
@@ -94,6 +125,7 @@ PyQueryResult packQueryResult(const QueryResult& r, ContactModel model) {
   out.penetrationDepth = arrays.depth;
   out.level = arrays.level;
   out.errorBound = arrays.errorBound;
+  putContactFeatures(arrays, out);
   out.budgetUsed = r.tests;
   out.sphereTests = r.sphereTests;
   out.triangleTests = r.triangleTests;
@@ -133,6 +165,7 @@ PyQueryResult runQuery(const PyBake& a, const ArrayLike& poseA, const PyBake& b,
 /// offsets[i]..offsets[i+1] of the contact arrays.
 struct PyBatchResult {
   py::array offsets, pos, normal, penetrationDepth, level, errorBound;
+  py::array featureKind, featureA, featureB, pointOnA, pointOnB;
   py::array budgetUsed, finished, colliding, stop, seconds, minLevel, maxLevel;
   std::string model;
   double wallSeconds = 0.0;
@@ -199,6 +232,7 @@ PyBatchResult runQueryBatch(const PyBake& a, const ArrayLike& posesAObj, const P
   out.penetrationDepth = arrays.depth;
   out.level = arrays.level;
   out.errorBound = arrays.errorBound;
+  putContactFeatures(arrays, out);
   out.budgetUsed = budgetUsed;
   out.finished = finished;
   out.colliding = colliding;
@@ -371,29 +405,24 @@ py::dict separationDict(const Separation& r) {
 }
 
 /// World.set_contact_callback: the Python callable gets (a, b, pos (C, 3), normal (C, 3), depth
-/// (C,), substep) and returns a truth value (False disables the pair for the step). It runs inside
-/// step(), which released the GIL: the wrapper takes it back for the call.
-void setContactCallback(PyWorld& w, const py::object& callback) {
+/// (C,), substep), and with features=True a seventh argument, the dict of ContactArrays::features,
+/// and returns a truth value (False disables the pair for the step). It runs inside step(),
+/// which released the GIL: the wrapper takes it back for the call.
+void setContactCallback(PyWorld& w, const py::object& callback, bool features) {
   if (callback.is_none()) {
     w.world.setContactCallback({});
     return;
   }
   if (!PyCallable_Check(callback.ptr())) invalidArgument("callback: expected a callable or None");
   auto held = std::make_shared<py::object>(callback);
-  w.world.setContactCallback([held](const ContactPairEvent& e) {
+  w.world.setContactCallback([held, features](const ContactPairEvent& e) {
     py::gil_scoped_acquire acquire;
-    const py::ssize_t n = static_cast<py::ssize_t>(e.contacts.size());
-    py::array_t<double> pos({n, py::ssize_t(3)}), normal({n, py::ssize_t(3)}), depth(n);
-    for (py::ssize_t i = 0; i < n; ++i) {
-      const Contact& c = e.contacts[static_cast<std::size_t>(i)];
-      for (int k = 0; k < 3; ++k) {
-        pos.mutable_data()[3 * i + k] = c.point[k];
-        normal.mutable_data()[3 * i + k] = c.normal[k];
-      }
-      depth.mutable_data()[i] = c.depth;
-    }
+    ContactArrays arrays(e.contacts.size());
+    for (std::size_t i = 0; i < e.contacts.size(); ++i) arrays.set(i, e.contacts[i]);
     // A Python exception becomes py::error_already_set and leaves step() with it.
-    return py::bool_((*held)(e.a, e.b, pos, normal, depth, e.substep)).cast<bool>();
+    const py::object answer = features ? (*held)(e.a, e.b, arrays.pos, arrays.normal, arrays.depth, e.substep, arrays.features())
+                                       : (*held)(e.a, e.b, arrays.pos, arrays.normal, arrays.depth, e.substep);
+    return py::bool_(answer).cast<bool>();
   });
 }
 
@@ -625,6 +654,12 @@ void bindDynamics(py::module_& mod) {
   py::list modelNames;
   for (ContactModel model : allContactModels()) modelNames.append(std::string(contactModelName(model)));
   mod.attr("contact_models") = modelNames;
+  // What QueryResult.feature_a / feature_b index (contact.h ContactFeature).
+  mod.attr("CONTACT_FEATURE_NONE") = static_cast<int>(ContactFeature::kNone);
+  mod.attr("CONTACT_FEATURE_TRIANGLE") = static_cast<int>(ContactFeature::kTriangle);
+  mod.attr("CONTACT_FEATURE_SPHERE") = static_cast<int>(ContactFeature::kSphere);
+  mod.attr("CONTACT_FEATURE_CELL") = static_cast<int>(ContactFeature::kCell);
+  mod.attr("NO_CONTACT_FEATURE") = kNoContactFeature;
 
   py::class_<PyQueryResult>(mod, "QueryResult",
                             "Contacts between two bodies (clod.query), world frame, as arrays with one row per contact,\n"
@@ -635,6 +670,17 @@ void bindDynamics(py::module_& mod) {
       .def_readonly("level", &PyQueryResult::level, "(C,) uint32: hierarchy level the contact came from (0 = roots)")
       .def_readonly("error_bound", &PyQueryResult::errorBound,
                     "(C,) float64: how far the contact may be off (length units; 0 for exact contacts)")
+      .def_readonly("feature_kind", &PyQueryResult::featureKind,
+                    "(C,) uint8: what feature_a / feature_b index: CONTACT_FEATURE_NONE (0), _TRIANGLE (1, mesh\n"
+                    "triangles: the exact model), _SPHERE (2, sphere-tree spheres: dos, average, cfm) or _CELL (3,\n"
+                    "contact-tree nodes)")
+      .def_readonly("feature_a", &PyQueryResult::featureA,
+                    "(C,) uint32: the feature of body A the contact came from (NO_CONTACT_FEATURE when unknown)")
+      .def_readonly("feature_b", &PyQueryResult::featureB, "(C,) uint32: the feature of body B")
+      .def_readonly("point_on_a", &PyQueryResult::pointOnA,
+                    "(C, 3) float64: the contact's point on A, pos - depth / 2 * normal (contact.h contactPointOnA)")
+      .def_readonly("point_on_b", &PyQueryResult::pointOnB,
+                    "(C, 3) float64: the contact's point on B, pos + depth / 2 * normal; (a - b) . normal = -depth")
       .def_readonly("budget_used", &PyQueryResult::budgetUsed, "tests made (sphere + triangle), never more than the budget")
       .def_readonly("sphere_tests", &PyQueryResult::sphereTests, "sphere-sphere tests of the traversal")
       .def_readonly("triangle_tests", &PyQueryResult::triangleTests, "triangle-triangle tests (exact model)")
@@ -678,6 +724,11 @@ void bindDynamics(py::module_& mod) {
       .def_readonly("penetration_depth", &PyBatchResult::penetrationDepth, "(C,) float64")
       .def_readonly("level", &PyBatchResult::level, "(C,) uint32")
       .def_readonly("error_bound", &PyBatchResult::errorBound, "(C,) float64")
+      .def_readonly("feature_kind", &PyBatchResult::featureKind, "(C,) uint8, as QueryResult.feature_kind")
+      .def_readonly("feature_a", &PyBatchResult::featureA, "(C,) uint32")
+      .def_readonly("feature_b", &PyBatchResult::featureB, "(C,) uint32")
+      .def_readonly("point_on_a", &PyBatchResult::pointOnA, "(C, 3) float64")
+      .def_readonly("point_on_b", &PyBatchResult::pointOnB, "(C, 3) float64")
       .def_readonly("budget_used", &PyBatchResult::budgetUsed, "(P,) uint64: tests per query")
       .def_readonly("finished", &PyBatchResult::finished, "(P,) bool")
       .def_readonly("colliding", &PyBatchResult::colliding, "(P,) bool")
@@ -761,6 +812,15 @@ void bindDynamics(py::module_& mod) {
             return out;
           },
           "(C, 2, 3) float64: per contact the point on body a and the point on body b the solver holds apart")
+      .def_property_readonly(
+          "contact_features", [](const StepReport& r) {
+            ContactArrays arrays(r.contacts.size());
+            for (std::size_t i = 0; i < r.contacts.size(); ++i) arrays.set(i, r.contacts[i]);
+            return arrays.features();
+          },
+          "the last substep's contacts' features as a dict of arrays: feature_kind (C,) uint8, feature_a and\n"
+          "feature_b (C,) uint32 (features of contact_bodies' a and b), point_on_a and point_on_b (C, 3) float64\n"
+          "(contact.h contactPointOnA/B; contact_points are where the solver anchored them)")
       .def_property_readonly(
           "pairs", [](const StepReport& r) {
             const py::ssize_t n = static_cast<py::ssize_t>(r.pairs.size());
@@ -943,9 +1003,11 @@ void bindDynamics(py::module_& mod) {
             return py::make_tuple(f.group, f.mask);
           },
           py::arg("id"), "(group, mask) of a body")
-      .def("set_contact_callback", &setContactCallback, py::arg("callback"),
+      .def("set_contact_callback", &setContactCallback, py::arg("callback"), py::kw_only(), py::arg("features") = false,
            "callback(a, b, pos, normal, depth, substep) -> bool, called per pair with contacts in every substep\n"
            "(pos, normal (C, 3), depth (C,)); False disables the pair for the rest of the step. None removes it.\n"
+           "features=True adds a seventh argument: a dict of feature_kind (C,) uint8, feature_a, feature_b (C,)\n"
+           "uint32 and point_on_a, point_on_b (C, 3), as in QueryResult (body a is the contacts' A).\n"
            "It must not edit the world. Slows stepping: the GIL is taken for each call.")
       .def(
           "separation", [](const PyWorld& self, BodyId a, BodyId b, double maxDistance) {
