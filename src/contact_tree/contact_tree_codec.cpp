@@ -32,13 +32,14 @@ constexpr int kDepthContexts = 16;
 struct Models {
   BitModel interior[kDepthContexts];
   BitModel surface[2][3][2];  // [split][|centre estimate| / radius bucket][corner signs differ]
-  BitModel errorHigh[2][kDepthContexts][128];
-  BitModel errorLow[2][8][256];  // [split][low 3 bits of the high byte]
+  BitModel errorFar[2][kDepthContexts];  // [split][depth]: the code is the Lipschitz cap farErrorCode
+  BitModel errorHigh[2][2][kDepthContexts][128];  // [split][surface][depth]
+  BitModel errorLow[2][8][16];  // [split][low 3 bits of the high byte]: the 4 bits above the zero nibble
   IntModel lattice[3][kDepthContexts];  // [odd coordinates - 1: edge, face, centre][depth]
   IntModel normal[2][2];                // [split][component]
   IntModel offset[2];
   BitModel fitHigh[2][kDepthContexts][128];
-  BitModel fitLow[2][8][256];
+  BitModel fitLow[2][8][16];
   BitModel normalFromAncestor[2][2];  // [split][the cell has an ancestor with a half-space]
 };
 
@@ -166,9 +167,14 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
       if (d < tree.maxDepth) enc.encodeBit(models->interior[dc], split ? 1u : 0u);
       const NodeGuess guess = guessNode(tree, corners, d);
       enc.encodeBit(models->surface[split][guess.surfaceBucket][guess.signChange], hs ? 1u : 0u);
-      if (code > 0x7f7f) bad("error code is not a finite bound");
-      enc.encodeTree(models->errorHigh[split][dc], 7, code >> 8);
-      enc.encodeTree(models->errorLow[split][(code >> 8) & 7u], 8, code & 0xffu);
+      // The Lipschitz cap or a code with a zero low nibble (ContactTree::roundErrorCodeUp).
+      const bool farCode = code == tree.farErrorCode(d);
+      enc.encodeBit(models->errorFar[split][dc], farCode ? 1u : 0u);
+      if (!farCode) {
+        if (code > 0x7f70 || (code & 15u) != 0) bad("error code is not one the codec stores (a 3-bit mantissa, rounded up)");
+        enc.encodeTree(models->errorHigh[split][hs ? 1 : 0][dc], 7, code >> 8);
+        enc.encodeTree(models->errorLow[split][(code >> 8) & 7u], 4, (code >> 4) & 15u);
+      }
 
       if (hs) {
         std::array<std::int32_t, 2> oct{};
@@ -207,7 +213,7 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
         if (!detail::findFitCode(hs->fitError, tree.cellSize(d), fitCode)) bad("half-space fit error is not one the codec stores");
         enc.encodeInt(models->offset[split], offsetUnits);
         enc.encodeTree(models->fitHigh[split][dc], 7, fitCode >> 8u);
-        enc.encodeTree(models->fitLow[split][(fitCode >> 8) & 7u], 8, fitCode & 0xffu);
+        enc.encodeTree(models->fitLow[split][(fitCode >> 8) & 7u], 4, (fitCode >> 4) & 15u);
       }
     }
     level.swap(next);
@@ -222,7 +228,9 @@ ContactTree decodeContactTree(ByteReader& in) {
   if (version != kContactTreeCodecVersion) {
     throw Error(ErrorCode::kBakeVersion, in.context() + ": contact tree: version " + std::to_string(version) +
                                              " is not the supported version " + std::to_string(kContactTreeCodecVersion) +
-                                             (version < kContactTreeCodecVersion ? " (an older, uncompressed layout): re-bake the mesh" : ""));
+                                             (version < 3 ? " (an older, uncompressed layout): re-bake the mesh"
+                                              : version < kContactTreeCodecVersion ? " (an older coding): re-bake the mesh"
+                                                                                   : ""));
   }
   ContactTree tree;
   for (int a = 0; a < 3; ++a) tree.origin[a] = in.read<double>();
@@ -280,9 +288,12 @@ ContactTree decodeContactTree(ByteReader& in) {
       const bool split = d < tree.maxDepth && dec.decodeBit(models->interior[dc]) != 0;
       const NodeGuess guess = guessNode(tree, corners, d);
       const bool surface = dec.decodeBit(models->surface[split][guess.surfaceBucket][guess.signChange]) != 0;
-      const std::uint32_t high = dec.decodeTree(models->errorHigh[split][dc], 7);
-      const std::uint32_t code = (high << 8) | dec.decodeTree(models->errorLow[split][high & 7u], 8);
-      if (code > 0x7f7f) fail("errorCode[" + std::to_string(node) + "] is not a finite bound >= 0");
+      std::uint32_t code = tree.farErrorCode(d);
+      if (dec.decodeBit(models->errorFar[split][dc]) == 0) {
+        const std::uint32_t high = dec.decodeTree(models->errorHigh[split][surface ? 1 : 0][dc], 7);
+        code = (high << 8) | (dec.decodeTree(models->errorLow[split][high & 7u], 4) << 4);
+        if (code > 0x7f70) fail("errorCode[" + std::to_string(node) + "] is not a finite bound >= 0");
+      }
       tree.errorCode.push_back(static_cast<std::uint16_t>(code));
       interiorFlags.push_back(split ? 1 : 0);
       surfaceFlags.push_back(surface ? 1 : 0);
@@ -313,8 +324,8 @@ ContactTree decodeContactTree(ByteReader& in) {
       if (surface) {
         const std::int64_t offsetUnits = dec.decodeInt(models->offset[split]);
         const std::uint32_t fitHigh = dec.decodeTree(models->fitHigh[split][dc], 7);
-        const std::uint32_t fitCode = (fitHigh << 8) | dec.decodeTree(models->fitLow[split][fitHigh & 7u], 8);
-        if (!(std::abs(double(offsetUnits)) < kMaxUnits) || fitCode > 0x7f7f) fail("half-space of node " + std::to_string(node) + " is out of range");
+        const std::uint32_t fitCode = (fitHigh << 8) | (dec.decodeTree(models->fitLow[split][fitHigh & 7u], 4) << 4);
+        if (!(std::abs(double(offsetUnits)) < kMaxUnits) || fitCode > 0x7f70) fail("half-space of node " + std::to_string(node) + " is out of range");
         hs.offset = detail::storedValue(detail::offsetPrediction(corners, split, lattice[13]), offsetUnits, hsStep);
         hs.fitError = detail::fitErrorFromCode(static_cast<std::uint16_t>(fitCode), tree.cellSize(d));
         if (!std::isfinite(hs.offset) || !std::isfinite(hs.fitError)) fail("half-space of node " + std::to_string(node) + " is not finite");

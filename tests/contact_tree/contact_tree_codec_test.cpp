@@ -140,21 +140,29 @@ TEST(ContactTreeCompactCodec, EncoderRefusesValuesItCannotStoreExactly) {
   ASSERT_FALSE(tilted.halfSpaces.empty());
   tilted.halfSpaces[0].normal[0] = std::nextafter(tilted.halfSpaces[0].normal[0], 2.0f);  // no octahedral code
   EXPECT_TRUE(refused(tilted));
+  // An error bound with more than the stored 3-bit mantissa (the root is always measured).
+  ContactTree fineBound = built.tree;
+  const std::uint16_t far = fineBound.farErrorCode(0);
+  fineBound.errorCode[0] = static_cast<std::uint16_t>((far & ~15u) | ((far & 15u) == 7 ? 5u : 7u));
+  EXPECT_TRUE(refused(fineBound));
 }
 
 TEST(ContactTreeCompactCodec, OlderVersionsAskForARebake) {
   const auto& built = sharedTree("spot.obj");
   ByteWriter writer;
   encodeContactTree(built.tree, writer);
-  std::vector<std::byte> bytes = writer.bytes();
-  bytes[0] = std::byte{2};  // the codec's own u32 version, little-endian: the float-array layout
-  ByteReader reader(bytes.data(), bytes.size(), "old");
-  try {
-    (void)decodeContactTree(reader);
-    FAIL() << "a version-2 payload was decoded";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ErrorCode::kBakeVersion);
-    EXPECT_NE(std::string(e.what()).find("re-bake"), std::string::npos) << e.what();
+  // 2: the float-array layout; 3: 7-bit error mantissas and finer half-space offsets.
+  for (const int version : {2, 3}) {
+    std::vector<std::byte> bytes = writer.bytes();
+    bytes[0] = std::byte(version);  // the codec's own u32 version, little-endian
+    ByteReader reader(bytes.data(), bytes.size(), "old");
+    try {
+      (void)decodeContactTree(reader);
+      ADD_FAILURE() << "a version-" << version << " payload was decoded";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kBakeVersion);
+      EXPECT_NE(std::string(e.what()).find("re-bake"), std::string::npos) << e.what();
+    }
   }
 }
 
