@@ -26,6 +26,25 @@ using detail::kLatticeSlot;
 constexpr double kMaxUnits = 70368744177664.0;  // 2^46
 constexpr int kDepthContexts = 16;
 
+// What the residuals of a split node coded so far say about the next one: their mean magnitude
+// (the field's curvature at this cell's scale: an edge or a bend gives large residuals all
+// over the block, a flat face zeros) and the sign of the last nonzero one (convex or concave).
+struct LatticeActivity {
+  static constexpr int kContexts = 7 * 3;
+  std::uint64_t sum = 0;
+  int count = 0;
+  int lastSign = 0;  // 0 none yet, 1 positive, 2 negative
+  int context() const {
+    const int magnitude = count == 0 ? 6 : std::min(5, static_cast<int>(std::bit_width(sum / static_cast<std::uint64_t>(count))));
+    return magnitude * 3 + lastSign;
+  }
+  void add(std::int64_t u) {
+    sum += static_cast<std::uint64_t>(std::min<std::int64_t>(u < 0 ? -u : u, std::int64_t{1} << 40));
+    ++count;
+    if (u != 0) lastSign = u > 0 ? 1 : 2;
+  }
+};
+
 // Adaptive models of everything the stream holds; encoder and decoder start from the same
 // state and update them identically. Contexts: what the decoder already knows about a node
 // (its depth, whether it is split, where the field's zero set is).
@@ -35,7 +54,8 @@ struct Models {
   BitModel errorFar[2][kDepthContexts];  // [split][depth]: the code is the Lipschitz cap farErrorCode
   BitModel errorHigh[2][2][kDepthContexts][128];  // [split][surface][depth]
   BitModel errorLow[2][8][16];  // [split][low 3 bits of the high byte]: the 4 bits above the zero nibble
-  IntModel lattice[3][kDepthContexts];  // [odd coordinates - 1: edge, face, centre][depth]
+  // [odd coordinates - 1: edge, face, centre][depth][LatticeActivity::context()]
+  IntModel lattice[3][kDepthContexts][LatticeActivity::kContexts];
   IntModel normal[2][2];                // [split][component]
   IntModel offset[2];
   BitModel fitHigh[2][kDepthContexts][128];
@@ -192,12 +212,14 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
       }
       if (split) {
         const std::uint32_t block = (tree.firstChild(node) - 1) / 8;
+        LatticeActivity activity;
         for (int l = 0; l < kLatticeSize; ++l) {
           if (kLatticeSlot[l] < 0) continue;
           const float v = tree.lattice[std::size_t{block} * kContactTreeLatticePerNode + kLatticeSlot[l]];
           std::int64_t u = 0;
           if (!unitsOf(v, detail::latticePrediction(corners, l), step, u)) bad("lattice value is not its prediction plus a multiple of the value step");
-          enc.encodeInt(models->lattice[latticeClass(l)][dc], u);
+          enc.encodeInt(models->lattice[latticeClass(l)][dc][activity.context()], u);
+          activity.add(u);
           lattice[l] = v;
         }
         for (int c = 0; c < 8; ++c) lattice[detail::parentCornerLattice(c)] = corners[c];
@@ -310,9 +332,11 @@ ContactTree decodeContactTree(ByteReader& in) {
         hs.normal = detail::decodeOctNormal(cell.ancestorNormal[0], cell.ancestorNormal[1]);
       }
       if (split) {
+        LatticeActivity activity;
         for (int l = 0; l < kLatticeSize; ++l) {
           if (kLatticeSlot[l] < 0) continue;
-          const std::int64_t u = dec.decodeInt(models->lattice[latticeClass(l)][dc]);
+          const std::int64_t u = dec.decodeInt(models->lattice[latticeClass(l)][dc][activity.context()]);
+          activity.add(u);
           const float v = detail::storedValue(detail::latticePrediction(corners, l), u, step);
           if (!(std::abs(double(u)) < kMaxUnits) || !std::isfinite(v)) fail("lattice value of node " + std::to_string(node) + " is out of range");
           lattice[l] = v;
