@@ -212,12 +212,13 @@ struct ContactTree {
   }
   /// Interpolation error bound of the node's cell, in mesh units: the largest |trilinear -
   /// exact| measured at the cell's test points times the gap factor (docs/contact-tree.md:
-  /// 3x3x3 lattice + 8 octant centres), or, for a cell the builder proved far from the surface
+  /// 3x3x3 lattice + 8 octant centres, times 2; or, for a cell that took the builder's second
+  /// look, the 5x5x5 grid, times 1.5), or, for a cell the builder proved far from the surface
   /// without measuring, the Lipschitz bound of half the cell diagonal (plus the value rounding
   /// q/2, see valueStep()), which holds everywhere in the cell for any 1-Lipschitz field;
   /// never more than that, except in cells where the field
-  /// is discontinuous (open meshes: the measured bound, uncapped). Rounded up by at most 0.8 %
-  /// (errorCode). This is what a query stopped at this node reports, and what graceful
+  /// is discontinuous (open meshes: the measured bound, uncapped). Rounded up by at most
+  /// 12.5 % (errorCode, roundErrorCodeUp; the Lipschitz cap by at most 0.8 %). This is what a query stopped at this node reports, and what graceful
   /// degradation uses. `depth` must be the node's depth. O(1).
   double errorBound(std::uint32_t node, std::uint32_t depth) const {
     return decodeErrorRatio(errorCode[node]) * cellRadius(depth);
