@@ -118,9 +118,8 @@ struct ContactTree {
   /// Shape and surface bitmaps with rank counts, one word per 64 nodes (see the layout above).
   std::vector<ContactTreeNodeWord> nodeWords;
   /// Per node: its error bound divided by cellRadius(depth), as the upper 16 bits of an IEEE
-  /// float (sign 0, 8-bit exponent, 7-bit mantissa) rounded up to a 3-bit mantissa
-  /// (roundErrorCodeUp), so that the decoded bound is never below the builder's and at most
-  /// 2^-3 (12.5 %) above it; farErrorCode(depth) (just
+  /// float (sign 0, 8-bit exponent, 7-bit mantissa), rounded up, so that the decoded bound is
+  /// never below the builder's and at most 2^-7 (0.8 %) above it; farErrorCode(depth) (just
   /// above 1.0) is the Lipschitz bound of half the cell diagonal plus the value rounding q/2,
   /// which caps every bound except in cells where the builder found the field discontinuous
   /// (open meshes, docs/contact-tree.md). Use errorBound().
@@ -217,8 +216,8 @@ struct ContactTree {
   /// without measuring, the Lipschitz bound of half the cell diagonal (plus the value rounding
   /// q/2, see valueStep()), which holds everywhere in the cell for any 1-Lipschitz field;
   /// never more than that, except in cells where the field
-  /// is discontinuous (open meshes: the measured bound, uncapped). Rounded up by at most
-  /// 12.5 % (errorCode, roundErrorCodeUp; the Lipschitz cap by at most 0.8 %). This is what a query stopped at this node reports, and what graceful
+  /// is discontinuous (open meshes: the measured bound, uncapped). Rounded up by at most 0.8 %
+  /// (errorCode). This is what a query stopped at this node reports, and what graceful
   /// degradation uses. `depth` must be the node's depth. O(1).
   double errorBound(std::uint32_t node, std::uint32_t depth) const {
     return decodeErrorRatio(errorCode[node]) * cellRadius(depth);
@@ -227,13 +226,6 @@ struct ContactTree {
   /// that decodeErrorRatio(code) >= ratio; ratios beyond the float range map to the largest
   /// finite code 0x7f7f. Precondition: ratio >= 0, not NaN.
   static std::uint16_t encodeErrorRatio(double ratio);
-  /// The codes the builder stores and the bake file holds: `code` rounded up to the next code
-  /// whose low 4 bits are zero (a 3-bit mantissa), so a stored bound is at most 2^-3 (12.5 %)
-  /// above the measured one; the Lipschitz cap farErrorCode() is the one code kept at full
-  /// precision. Codes above 0x7f70 (ratios beyond 2^127, never met) map to 0x7f70. O(1).
-  static std::uint16_t roundErrorCodeUp(std::uint16_t code) {
-    return code >= 0x7f70 ? std::uint16_t{0x7f70} : static_cast<std::uint16_t>((code + 15u) & ~15u);
-  }
   /// Inverse of encodeErrorRatio: a float whose upper 16 bits are `code`.
   static float decodeErrorRatio(std::uint16_t code) {
     return std::bit_cast<float>(static_cast<std::uint32_t>(code) << 16);

@@ -8,14 +8,14 @@
 //   (src/contact_tree/range_coder.h). What the corners of a node prove (ContactTree::provenFar)
 //   is not stored: such a node is a leaf without a half-space and with farErrorCode. For every
 //   other node: split bit (not at maxDepth), surface bit, the error code (one bit for the
-//   Lipschitz cap farErrorCode, else its upper 12 bits: ContactTree::roundErrorCodeUp); for a split
+//   Lipschitz cap farErrorCode, else its 16 bits); for a split
 //   node its 19 lattice values as integers of ContactTree::valueStep(), each minus the trilinear
 //   prediction from the node's corners; for a surface cell the half-space's octahedral normal
 //   code minus that of the trilinear gradient, its offset (units of halfSpaceStep()) minus the
-//   centre value, and its fit error (upper 12 bits of its code). Lossless for trees from buildContactTree, which rounds
+//   centre value, and its fit error. Lossless for trees from buildContactTree, which rounds
 //   every value onto these grids (the encoder refuses any other tree with kInvalidArgument).
-//   Versions 1 and 2 (uncompressed arrays of floats) and 3 (7-bit mantissas, offsets in steps of
-//   1/1024) are refused with kBakeVersion: re-bake.
+//   Versions 1 and 2 (uncompressed arrays of floats) and 3 (the first coding, without the cap
+//   bit and the lattice contexts) are refused with kBakeVersion: re-bake.
 
 #include "clod/byte_stream.h"
 #include "clod/contact_tree.h"

@@ -336,7 +336,7 @@ void Builder::measureCell(const PendingCell& cell, std::uint32_t depth, double* 
       const Vec3 offset = 0.5 * h * Vec3((l % 3) - 1.0, ((l / 3) % 3) - 1.0, (l / 9) - 1.0);
       fit = std::max(fit, std::abs(nr.dot(offset) - double(r.halfSpace.offset) - exact[l]));
     }
-    r.halfSpace.fitError = detail::fitErrorFromCode(ContactTree::roundErrorCodeUp(ContactTree::encodeErrorRatio(fit / h)), h);
+    r.halfSpace.fitError = detail::fitErrorFromCode(ContactTree::encodeErrorRatio(fit / h), h);
   }
 }
 
@@ -387,7 +387,7 @@ ContactTree Builder::build(ContactTreeBuildStats* stats) {
       // code up. Codes are monotone in the ratio, so the cap applies to the codes.
       const std::uint16_t farCode = tree_.farErrorCode(depth);
       const std::uint16_t code =
-          r.far ? farCode : ContactTree::roundErrorCodeUp(ContactTree::encodeErrorRatio(double(r.error) / tree_.cellRadius(depth)));
+          r.far ? farCode : ContactTree::encodeErrorRatio(double(r.error) / tree_.cellRadius(depth));
       tree_.errorCode.push_back(r.discontinuous ? code : std::min(code, farCode));
       surface.push_back(r.surface ? 1 : 0);
       if (r.surface) tree_.halfSpaces.push_back(r.halfSpace);

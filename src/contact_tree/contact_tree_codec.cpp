@@ -53,13 +53,13 @@ struct Models {
   BitModel surface[2][3][2];  // [split][|centre estimate| / radius bucket][corner signs differ]
   BitModel errorFar[2][kDepthContexts];  // [split][depth]: the code is the Lipschitz cap farErrorCode
   BitModel errorHigh[2][2][kDepthContexts][128];  // [split][surface][depth]
-  BitModel errorLow[2][8][16];  // [split][low 3 bits of the high byte]: the 4 bits above the zero nibble
+  BitModel errorLow[2][8][256];  // [split][low 3 bits of the high byte]
   // [odd coordinates - 1: edge, face, centre][depth][LatticeActivity::context()]
   IntModel lattice[3][kDepthContexts][LatticeActivity::kContexts];
   IntModel normal[2][2];                // [split][component]
   IntModel offset[2];
   BitModel fitHigh[2][kDepthContexts][128];
-  BitModel fitLow[2][8][16];
+  BitModel fitLow[2][8][256];
   BitModel normalFromAncestor[2][2];  // [split][the cell has an ancestor with a half-space]
 };
 
@@ -187,13 +187,13 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
       if (d < tree.maxDepth) enc.encodeBit(models->interior[dc], split ? 1u : 0u);
       const NodeGuess guess = guessNode(tree, corners, d);
       enc.encodeBit(models->surface[split][guess.surfaceBucket][guess.signChange], hs ? 1u : 0u);
-      // The Lipschitz cap or a code with a zero low nibble (ContactTree::roundErrorCodeUp).
+      // The Lipschitz cap (one bit) or the code's two bytes.
       const bool farCode = code == tree.farErrorCode(d);
       enc.encodeBit(models->errorFar[split][dc], farCode ? 1u : 0u);
       if (!farCode) {
-        if (code > 0x7f70 || (code & 15u) != 0) bad("error code is not one the codec stores (a 3-bit mantissa, rounded up)");
+        if (code > 0x7f7f) bad("error code is not a finite bound");
         enc.encodeTree(models->errorHigh[split][hs ? 1 : 0][dc], 7, code >> 8);
-        enc.encodeTree(models->errorLow[split][(code >> 8) & 7u], 4, (code >> 4) & 15u);
+        enc.encodeTree(models->errorLow[split][(code >> 8) & 7u], 8, code & 0xffu);
       }
 
       if (hs) {
@@ -235,7 +235,7 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
         if (!detail::findFitCode(hs->fitError, tree.cellSize(d), fitCode)) bad("half-space fit error is not one the codec stores");
         enc.encodeInt(models->offset[split], offsetUnits);
         enc.encodeTree(models->fitHigh[split][dc], 7, fitCode >> 8u);
-        enc.encodeTree(models->fitLow[split][(fitCode >> 8) & 7u], 4, (fitCode >> 4) & 15u);
+        enc.encodeTree(models->fitLow[split][(fitCode >> 8) & 7u], 8, fitCode & 0xffu);
       }
     }
     level.swap(next);
@@ -313,8 +313,8 @@ ContactTree decodeContactTree(ByteReader& in) {
       std::uint32_t code = tree.farErrorCode(d);
       if (dec.decodeBit(models->errorFar[split][dc]) == 0) {
         const std::uint32_t high = dec.decodeTree(models->errorHigh[split][surface ? 1 : 0][dc], 7);
-        code = (high << 8) | (dec.decodeTree(models->errorLow[split][high & 7u], 4) << 4);
-        if (code > 0x7f70) fail("errorCode[" + std::to_string(node) + "] is not a finite bound >= 0");
+        code = (high << 8) | dec.decodeTree(models->errorLow[split][high & 7u], 8);
+        if (code > 0x7f7f) fail("errorCode[" + std::to_string(node) + "] is not a finite bound >= 0");
       }
       tree.errorCode.push_back(static_cast<std::uint16_t>(code));
       interiorFlags.push_back(split ? 1 : 0);
@@ -348,8 +348,8 @@ ContactTree decodeContactTree(ByteReader& in) {
       if (surface) {
         const std::int64_t offsetUnits = dec.decodeInt(models->offset[split]);
         const std::uint32_t fitHigh = dec.decodeTree(models->fitHigh[split][dc], 7);
-        const std::uint32_t fitCode = (fitHigh << 8) | (dec.decodeTree(models->fitLow[split][fitHigh & 7u], 4) << 4);
-        if (!(std::abs(double(offsetUnits)) < kMaxUnits) || fitCode > 0x7f70) fail("half-space of node " + std::to_string(node) + " is out of range");
+        const std::uint32_t fitCode = (fitHigh << 8) | dec.decodeTree(models->fitLow[split][fitHigh & 7u], 8);
+        if (!(std::abs(double(offsetUnits)) < kMaxUnits) || fitCode > 0x7f7f) fail("half-space of node " + std::to_string(node) + " is out of range");
         hs.offset = detail::storedValue(detail::offsetPrediction(corners, split, lattice[13]), offsetUnits, hsStep);
         hs.fitError = detail::fitErrorFromCode(static_cast<std::uint16_t>(fitCode), tree.cellSize(d));
         if (!std::isfinite(hs.offset) || !std::isfinite(hs.fitError)) fail("half-space of node " + std::to_string(node) + " is not finite");

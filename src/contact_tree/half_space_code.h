@@ -11,9 +11,10 @@
 //    moves by at most 2^-14 eps_s (samples are placed on it, so it must stay that close: a
 //    box face cell next to an edge, where the prediction is not exact, keeps its face plane
 //    within 1e-6; a step of latticeStep / 16 moved it by 1.3e-5, ctest ContactTreeBox).
-//  * fitError: fitError / h as a 16-bit code rounded up to a 3-bit mantissa
-//    (ContactTree::roundErrorCodeUp), so it stays an upper bound and keeps its relative
-//    precision (2^-3) however small it is.
+//  * fitError: fitError / h as a 16-bit code rounded up (ContactTree::encodeErrorRatio), so it
+//    stays an upper bound and keeps its relative precision (2^-7) however small it is. (A
+//    3-bit mantissa, as the error bounds have, flips cells across the contact sampler's
+//    flat / edge threshold 0.1 h: a resting spot then tipped over in the world.)
 
 #include <array>
 #include <cmath>
@@ -84,13 +85,12 @@ inline float fitErrorFromCode(std::uint16_t code, double h) {
   if (double(f) < v) f = std::nextafter(f, 3.0e38f);
   return f;
 }
-/// The code (a multiple of 16, ContactTree::roundErrorCodeUp) of a stored fit error, or false
-/// if no such code gives exactly this value.
+/// The code of a stored fit error, or false if no code gives exactly this value.
 inline bool findFitCode(float fitError, double h, std::uint16_t& code) {
   if (!(fitError >= 0.0f) || !std::isfinite(fitError)) return false;
-  const std::uint16_t guess = ContactTree::roundErrorCodeUp(ContactTree::encodeErrorRatio(double(fitError) / h));
-  for (int c = int(guess) - 16; c <= int(guess) + 16; c += 16) {
-    if (c < 0 || c > 0x7f70) continue;
+  const std::uint16_t guess = ContactTree::encodeErrorRatio(double(fitError) / h);
+  for (int c = int(guess) - 1; c <= int(guess) + 1; ++c) {
+    if (c < 0 || c > 0x7f7f) continue;
     if (fitErrorFromCode(static_cast<std::uint16_t>(c), h) == fitError) {
       code = static_cast<std::uint16_t>(c);
       return true;

@@ -224,7 +224,7 @@ TEST_F(BakeContactTree, TrailingOrMissingPayloadBytesAndNewerVersionsAreRejected
   innerNewer[0] = std::byte{kContactTreeCodecVersion + 1};  // the codec's own u32 version, little-endian
   EXPECT_EQ(thrownCode([&] { decodeBake(fileWithTreePayload(baked_->contents, innerNewer)); }), ErrorCode::kBakeVersion);
   // Files from before the compact encoding (codec version 2: float arrays; version 1: 32-bit
-  // child indices) and from its first coding (version 3: 7-bit error mantissas) must not be
+  // child indices) and from its first coding (version 3) must not be
   // misread as the current layout: they are refused by version, with a message saying so and
   // asking for a re-bake.
   for (std::uint8_t old : {std::uint8_t{1}, std::uint8_t{2}, std::uint8_t{3}}) {

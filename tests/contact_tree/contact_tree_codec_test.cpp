@@ -140,18 +140,13 @@ TEST(ContactTreeCompactCodec, EncoderRefusesValuesItCannotStoreExactly) {
   ASSERT_FALSE(tilted.halfSpaces.empty());
   tilted.halfSpaces[0].normal[0] = std::nextafter(tilted.halfSpaces[0].normal[0], 2.0f);  // no octahedral code
   EXPECT_TRUE(refused(tilted));
-  // An error bound with more than the stored 3-bit mantissa (the root is always measured).
-  ContactTree fineBound = built.tree;
-  const std::uint16_t far = fineBound.farErrorCode(0);
-  fineBound.errorCode[0] = static_cast<std::uint16_t>((far & ~15u) | ((far & 15u) == 7 ? 5u : 7u));
-  EXPECT_TRUE(refused(fineBound));
 }
 
 TEST(ContactTreeCompactCodec, OlderVersionsAskForARebake) {
   const auto& built = sharedTree("spot.obj");
   ByteWriter writer;
   encodeContactTree(built.tree, writer);
-  // 2: the float-array layout; 3: 7-bit error mantissas and finer half-space offsets.
+  // 2: the float-array layout; 3: the first coding (no cap bit, no lattice contexts).
   for (const int version : {2, 3}) {
     std::vector<std::byte> bytes = writer.bytes();
     bytes[0] = std::byte(version);  // the codec's own u32 version, little-endian
