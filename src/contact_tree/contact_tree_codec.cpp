@@ -26,15 +26,36 @@ using detail::kLatticeSlot;
 constexpr double kMaxUnits = 70368744177664.0;  // 2^46
 constexpr int kDepthContexts = 16;
 
+// What the residuals of a split node coded so far say about the next one: their mean magnitude
+// (the field's curvature at this cell's scale: an edge or a bend gives large residuals all
+// over the block, a flat face zeros) and the sign of the last nonzero one (convex or concave).
+struct LatticeActivity {
+  static constexpr int kContexts = 7 * 3;
+  std::uint64_t sum = 0;
+  int count = 0;
+  int lastSign = 0;  // 0 none yet, 1 positive, 2 negative
+  int context() const {
+    const int magnitude = count == 0 ? 6 : std::min(5, static_cast<int>(std::bit_width(sum / static_cast<std::uint64_t>(count))));
+    return magnitude * 3 + lastSign;
+  }
+  void add(std::int64_t u) {
+    sum += static_cast<std::uint64_t>(std::min<std::int64_t>(u < 0 ? -u : u, std::int64_t{1} << 40));
+    ++count;
+    if (u != 0) lastSign = u > 0 ? 1 : 2;
+  }
+};
+
 // Adaptive models of everything the stream holds; encoder and decoder start from the same
 // state and update them identically. Contexts: what the decoder already knows about a node
 // (its depth, whether it is split, where the field's zero set is).
 struct Models {
   BitModel interior[kDepthContexts];
   BitModel surface[2][3][2];  // [split][|centre estimate| / radius bucket][corner signs differ]
-  BitModel errorHigh[2][kDepthContexts][128];
+  BitModel errorFar[2][kDepthContexts];  // [split][depth]: the code is the Lipschitz cap farErrorCode
+  BitModel errorHigh[2][2][kDepthContexts][128];  // [split][surface][depth]
   BitModel errorLow[2][8][256];  // [split][low 3 bits of the high byte]
-  IntModel lattice[3][kDepthContexts];  // [odd coordinates - 1: edge, face, centre][depth]
+  // [odd coordinates - 1: edge, face, centre][depth][LatticeActivity::context()]
+  IntModel lattice[3][kDepthContexts][LatticeActivity::kContexts];
   IntModel normal[2][2];                // [split][component]
   IntModel offset[2];
   BitModel fitHigh[2][kDepthContexts][128];
@@ -166,9 +187,14 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
       if (d < tree.maxDepth) enc.encodeBit(models->interior[dc], split ? 1u : 0u);
       const NodeGuess guess = guessNode(tree, corners, d);
       enc.encodeBit(models->surface[split][guess.surfaceBucket][guess.signChange], hs ? 1u : 0u);
-      if (code > 0x7f7f) bad("error code is not a finite bound");
-      enc.encodeTree(models->errorHigh[split][dc], 7, code >> 8);
-      enc.encodeTree(models->errorLow[split][(code >> 8) & 7u], 8, code & 0xffu);
+      // The Lipschitz cap (one bit) or the code's two bytes.
+      const bool farCode = code == tree.farErrorCode(d);
+      enc.encodeBit(models->errorFar[split][dc], farCode ? 1u : 0u);
+      if (!farCode) {
+        if (code > 0x7f7f) bad("error code is not a finite bound");
+        enc.encodeTree(models->errorHigh[split][hs ? 1 : 0][dc], 7, code >> 8);
+        enc.encodeTree(models->errorLow[split][(code >> 8) & 7u], 8, code & 0xffu);
+      }
 
       if (hs) {
         std::array<std::int32_t, 2> oct{};
@@ -186,12 +212,14 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
       }
       if (split) {
         const std::uint32_t block = (tree.firstChild(node) - 1) / 8;
+        LatticeActivity activity;
         for (int l = 0; l < kLatticeSize; ++l) {
           if (kLatticeSlot[l] < 0) continue;
           const float v = tree.lattice[std::size_t{block} * kContactTreeLatticePerNode + kLatticeSlot[l]];
           std::int64_t u = 0;
           if (!unitsOf(v, detail::latticePrediction(corners, l), step, u)) bad("lattice value is not its prediction plus a multiple of the value step");
-          enc.encodeInt(models->lattice[latticeClass(l)][dc], u);
+          enc.encodeInt(models->lattice[latticeClass(l)][dc][activity.context()], u);
+          activity.add(u);
           lattice[l] = v;
         }
         for (int c = 0; c < 8; ++c) lattice[detail::parentCornerLattice(c)] = corners[c];
@@ -222,7 +250,9 @@ ContactTree decodeContactTree(ByteReader& in) {
   if (version != kContactTreeCodecVersion) {
     throw Error(ErrorCode::kBakeVersion, in.context() + ": contact tree: version " + std::to_string(version) +
                                              " is not the supported version " + std::to_string(kContactTreeCodecVersion) +
-                                             (version < kContactTreeCodecVersion ? " (an older, uncompressed layout): re-bake the mesh" : ""));
+                                             (version < 3 ? " (an older, uncompressed layout): re-bake the mesh"
+                                              : version < kContactTreeCodecVersion ? " (an older coding): re-bake the mesh"
+                                                                                   : ""));
   }
   ContactTree tree;
   for (int a = 0; a < 3; ++a) tree.origin[a] = in.read<double>();
@@ -280,9 +310,12 @@ ContactTree decodeContactTree(ByteReader& in) {
       const bool split = d < tree.maxDepth && dec.decodeBit(models->interior[dc]) != 0;
       const NodeGuess guess = guessNode(tree, corners, d);
       const bool surface = dec.decodeBit(models->surface[split][guess.surfaceBucket][guess.signChange]) != 0;
-      const std::uint32_t high = dec.decodeTree(models->errorHigh[split][dc], 7);
-      const std::uint32_t code = (high << 8) | dec.decodeTree(models->errorLow[split][high & 7u], 8);
-      if (code > 0x7f7f) fail("errorCode[" + std::to_string(node) + "] is not a finite bound >= 0");
+      std::uint32_t code = tree.farErrorCode(d);
+      if (dec.decodeBit(models->errorFar[split][dc]) == 0) {
+        const std::uint32_t high = dec.decodeTree(models->errorHigh[split][surface ? 1 : 0][dc], 7);
+        code = (high << 8) | dec.decodeTree(models->errorLow[split][high & 7u], 8);
+        if (code > 0x7f7f) fail("errorCode[" + std::to_string(node) + "] is not a finite bound >= 0");
+      }
       tree.errorCode.push_back(static_cast<std::uint16_t>(code));
       interiorFlags.push_back(split ? 1 : 0);
       surfaceFlags.push_back(surface ? 1 : 0);
@@ -299,9 +332,11 @@ ContactTree decodeContactTree(ByteReader& in) {
         hs.normal = detail::decodeOctNormal(cell.ancestorNormal[0], cell.ancestorNormal[1]);
       }
       if (split) {
+        LatticeActivity activity;
         for (int l = 0; l < kLatticeSize; ++l) {
           if (kLatticeSlot[l] < 0) continue;
-          const std::int64_t u = dec.decodeInt(models->lattice[latticeClass(l)][dc]);
+          const std::int64_t u = dec.decodeInt(models->lattice[latticeClass(l)][dc][activity.context()]);
+          activity.add(u);
           const float v = detail::storedValue(detail::latticePrediction(corners, l), u, step);
           if (!(std::abs(double(u)) < kMaxUnits) || !std::isfinite(v)) fail("lattice value of node " + std::to_string(node) + " is out of range");
           lattice[l] = v;

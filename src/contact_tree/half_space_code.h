@@ -8,9 +8,13 @@
 //    decoded normal is normalised in double and stored as float. Angular error < 5e-5 rad.
 //  * offset: the centre estimate (-centre value of a split cell, else -trilinear centre value)
 //    plus an integer multiple of latticeStep / 1024 (lattice.h), rounded to nearest: the plane
-//    moves by at most 2^-14 eps_s (samples are placed on it, so it must stay that close).
+//    moves by at most 2^-14 eps_s (samples are placed on it, so it must stay that close: a
+//    box face cell next to an edge, where the prediction is not exact, keeps its face plane
+//    within 1e-6; a step of latticeStep / 16 moved it by 1.3e-5, ctest ContactTreeBox).
 //  * fitError: fitError / h as a 16-bit code rounded up (ContactTree::encodeErrorRatio), so it
-//    stays an upper bound and keeps its relative precision (2^-7) however small it is.
+//    stays an upper bound and keeps its relative precision (2^-7) however small it is. (A
+//    3-bit mantissa, as the error bounds have, flips cells across the contact sampler's
+//    flat / edge threshold 0.1 h: a resting spot then tipped over in the world.)
 
 #include <array>
 #include <cmath>

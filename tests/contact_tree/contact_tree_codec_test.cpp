@@ -146,15 +146,18 @@ TEST(ContactTreeCompactCodec, OlderVersionsAskForARebake) {
   const auto& built = sharedTree("spot.obj");
   ByteWriter writer;
   encodeContactTree(built.tree, writer);
-  std::vector<std::byte> bytes = writer.bytes();
-  bytes[0] = std::byte{2};  // the codec's own u32 version, little-endian: the float-array layout
-  ByteReader reader(bytes.data(), bytes.size(), "old");
-  try {
-    (void)decodeContactTree(reader);
-    FAIL() << "a version-2 payload was decoded";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ErrorCode::kBakeVersion);
-    EXPECT_NE(std::string(e.what()).find("re-bake"), std::string::npos) << e.what();
+  // 2: the float-array layout; 3: the first coding (no cap bit, no lattice contexts).
+  for (const int version : {2, 3}) {
+    std::vector<std::byte> bytes = writer.bytes();
+    bytes[0] = std::byte(version);  // the codec's own u32 version, little-endian
+    ByteReader reader(bytes.data(), bytes.size(), "old");
+    try {
+      (void)decodeContactTree(reader);
+      ADD_FAILURE() << "a version-" << version << " payload was decoded";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kBakeVersion);
+      EXPECT_NE(std::string(e.what()).find("re-bake"), std::string::npos) << e.what();
+    }
   }
 }
 
