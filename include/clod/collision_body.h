@@ -82,7 +82,8 @@ public:
   }
   double sphereSupportSlack(std::uint32_t sphere) const noexcept { return supportSlack_[sphere]; }
   /// For a sphere with support vertices: the vertices of its triangles that the support set
-  /// leaves out (they lie inside the patch's convex hull, so only a non-convex patch has them)
+  /// leaves out (they lie inside the patch's convex hull, so, but for vertices on the rim of a
+  /// flat hull face that qhull's joggle may drop, only a non-convex patch has them)
   /// and that do not lie inside a flat region of the mesh (a vertex all of whose triangles share
   /// one normal and none of whose edges is a border), ascending, when there are at most
   /// kMaxSphereInnerVertices of them; empty otherwise. A non-convex patch can rest on them while
