@@ -81,6 +81,20 @@ public:
             supportVertexOffsets_[sphere + 1] - supportVertexOffsets_[sphere]};
   }
   double sphereSupportSlack(std::uint32_t sphere) const noexcept { return supportSlack_[sphere]; }
+  /// For a sphere with support vertices: the vertices of its triangles that the support set
+  /// leaves out (they lie inside the patch's convex hull, so, but for vertices on the rim of a
+  /// flat hull face that qhull's joggle may drop, only a non-convex patch has them)
+  /// and that do not lie inside a flat region of the mesh (a vertex all of whose triangles share
+  /// one normal and none of whose edges is a border), ascending, when there are at most
+  /// kMaxSphereInnerVertices of them; empty otherwise. A non-convex patch can rest on them while
+  /// its hull's vertices are outside the other body: the flank of a bump under a box's edge,
+  /// before the bump's top reaches the box. The cfm model presses them into convex bodies with
+  /// the support vertices (docs/narrow-phase.md, "Curved patches"); a flat region's inner
+  /// vertices are left out because its border vertices, which are kept, give the same plane.
+  std::span<const std::uint32_t> sphereInnerVertices(std::uint32_t sphere) const noexcept {
+    return {innerVertices_.data() + innerVertexOffsets_[sphere], innerVertexOffsets_[sphere + 1] - innerVertexOffsets_[sphere]};
+  }
+  static constexpr std::uint32_t kMaxSphereInnerVertices = 1024;
   /// Outward unit normal at a mesh vertex: the angle-weighted mean of its triangles' normals
   /// (zero for an unused vertex). A curved patch's vertex pressed into a convex body leaves it
   /// through the face this normal faces (docs/narrow-phase.md, "Curved patches").
@@ -140,6 +154,8 @@ private:
   std::vector<std::uint32_t> supportVertexOffsets_;
   std::vector<std::uint32_t> supportVertices_;
   std::vector<double> supportSlack_;
+  std::vector<std::uint32_t> innerVertexOffsets_;
+  std::vector<std::uint32_t> innerVertices_;
   std::vector<Vec3f> vertexNormals_;
   double diagonal_ = 0.0;
   bool convexPolyhedron_ = false;     // closed and convex (isConvexPolyhedron)

@@ -78,6 +78,33 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree) : mesh_(std::mo
     if (x.v0 != y.v0) return x.v0 < y.v0;
     return x.v1 != y.v1 ? x.v1 < y.v1 : x.triangle < y.triangle;
   });
+  // Vertices inside a flat region: every triangle around them has one normal (to ~1e-6 rad, as
+  // face normals are counted) and none of their edges is a border. Not counted as inner vertices.
+  std::vector<std::uint8_t> flatInside(mesh_.vertices.size(), 1);
+  {
+    std::vector<Vec3> firstNormal(mesh_.vertices.size(), Vec3::Zero());
+    for (std::uint32_t t = 0; t < mesh_.triangleCount(); ++t) {
+      const Vec3 n = mesh_.triangleNormal(t);
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t v = mesh_.triangles[t][k];
+        if (n.squaredNorm() == 0.0) {
+          flatInside[v] = 0;
+        } else if (firstNormal[v].squaredNorm() == 0.0) {
+          firstNormal[v] = n;
+        } else if (firstNormal[v].dot(n) <= 1.0 - 5e-13) {
+          flatInside[v] = 0;
+        }
+      }
+    }
+    for (std::size_t i = 0; i < edges.size();) {
+      std::size_t j = i;
+      while (j < edges.size() && edges[j].v0 == edges[i].v0 && edges[j].v1 == edges[i].v1) ++j;
+      if (j - i != 2) flatInside[edges[i].v0] = flatInside[edges[i].v1] = 0;
+      i = j;
+    }
+  }
+  innerVertexOffsets_.assign(1, 0);
+  std::vector<std::uint32_t> inner;
   for (std::uint32_t i = 0; i < tree_.sphereCount(); ++i) {
     distinct.clear();
     for (std::uint32_t t : tree_.triangles(i)) {
@@ -138,6 +165,21 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree) : mesh_(std::mo
     const bool hasPatch = patchVertexOffsets_[i + 1] > patchVertexOffsets_[i];
     supportSlack_.push_back(hasPatch ? 0.0 : detail::appendPatchSupportVertices(mesh_, tree_.triangles(i), supportVertices_));
     supportVertexOffsets_.push_back(static_cast<std::uint32_t>(supportVertices_.size()));
+    // Inner vertices: those of the patch the support set leaves out, not inside a flat region.
+    if (!hasPatch) {
+      const std::span<const std::uint32_t> support = sphereSupportVertices(i);  // ascending
+      inner.clear();
+      for (std::uint32_t t : tree_.triangles(i)) {
+        for (int k = 0; k < 3; ++k) {
+          const std::uint32_t v = mesh_.triangles[t][k];
+          if (!flatInside[v] && !std::binary_search(support.begin(), support.end(), v)) inner.push_back(v);
+        }
+      }
+      std::sort(inner.begin(), inner.end());
+      inner.erase(std::unique(inner.begin(), inner.end()), inner.end());
+      if (inner.size() <= kMaxSphereInnerVertices) innerVertices_.insert(innerVertices_.end(), inner.begin(), inner.end());
+    }
+    innerVertexOffsets_.push_back(static_cast<std::uint32_t>(innerVertices_.size()));
   }
   classifyConvexPolyhedron(edges);
   computeVertexNormals();

@@ -875,8 +875,9 @@ bool facedPatchContacts(const PatchSide& sideA, const PatchSide& sideB, const Co
 }
 
 // Contacts of a curved patch on a face of a convex body's faceted patch (a mesh dropped on a box,
-// at any level): every support vertex of the curved patch (CollisionBody::sphereSupportVertices)
-// that lies behind all of the faceted patch's face planes is
+// at any level): every support vertex of the curved patch (CollisionBody::sphereSupportVertices),
+// and every inner vertex of a non-convex one (sphereInnerVertices), that lies behind all of the
+// faceted patch's face planes is
 // inside it, and gives a contact at its depth below the face that faces it along the chosen
 // normal -- the points the body really rests on, with their own depths, where the single contact
 // of the pair stood at its sphere's centre with the sphere's depth (a bunny resting on one
@@ -910,41 +911,49 @@ bool vertexOnFaceContacts(const PatchSide& patch, const PatchSide& faceted, cons
   const double tolerance = 1e-9 * (patch.body.diagonal() + faceted.body.diagonal());
   const bool facetedIsB = toward.dot(c.normal) > 0.0;
   const std::size_t before = out.size();
-  // A faceted patch's own vertices (few; its support set is empty), else the curved patch's support set.
-  const std::span<const std::uint32_t> candidates =
-      patch.faceted ? patch.body.spherePatchVertices(patch.sphere) : patch.body.sphereSupportVertices(patch.sphere);
-  for (std::uint32_t id : candidates) {
-    const Vec3 v = patch.toA(patch.body.mesh().vertices[id]);
-    const Vec3 normal = patch.rotToA ? Vec3(*patch.rotToA * patch.body.vertexNormal(id)) : patch.body.vertexNormal(id);
-    bool inside = true;
-    std::size_t pressed = faces.size(), nearest = 0;
-    double depth = std::numeric_limits<double>::infinity(), nearestDepth = depth;
-    for (std::size_t k = 0; k < faces.size() && inside; ++k) {
-      const double d = halfSpaces[k].second - halfSpaces[k].first.dot(v);
-      inside = d > tolerance;
-      if (-halfSpaces[k].first.dot(normal) >= kMinFacingCos && d < depth) depth = d, pressed = k;
-      if (d < nearestDepth) nearestDepth = d, nearest = k;
+  // A faceted patch's own vertices (few; its support set is empty), else the curved patch's
+  // support set and its inner vertices (CollisionBody::sphereInnerVertices, only a non-convex
+  // patch has them): the flank of a bump can be inside the convex body while the hull's vertices
+  // (the bump's top and the patch's rim) are not. With the hull alone a box sliding onto a bump
+  // met no contact until the bump's top was inside it, 4 cm deep (`clod experiment
+  // flat-contact`: 239 -> 56 mm rms from the exact track).
+  const std::span<const std::uint32_t> lists[2] = {
+      patch.faceted ? patch.body.spherePatchVertices(patch.sphere) : patch.body.sphereSupportVertices(patch.sphere),
+      patch.faceted ? std::span<const std::uint32_t>() : patch.body.sphereInnerVertices(patch.sphere)};
+  for (const std::span<const std::uint32_t> candidates : lists) {
+    for (std::uint32_t id : candidates) {
+      const Vec3 v = patch.toA(patch.body.mesh().vertices[id]);
+      const Vec3 normal = patch.rotToA ? Vec3(*patch.rotToA * patch.body.vertexNormal(id)) : patch.body.vertexNormal(id);
+      bool inside = true;
+      std::size_t pressed = faces.size(), nearest = 0;
+      double depth = std::numeric_limits<double>::infinity(), nearestDepth = depth;
+      for (std::size_t k = 0; k < faces.size() && inside; ++k) {
+        const double d = halfSpaces[k].second - halfSpaces[k].first.dot(v);
+        inside = d > tolerance;
+        if (-halfSpaces[k].first.dot(normal) >= kMinFacingCos && d < depth) depth = d, pressed = k;
+        if (d < nearestDepth) nearestDepth = d, nearest = k;
+      }
+      if (!inside) continue;
+      // No face it faces, or one much deeper than the nearest face: the nearest face. A vertex
+      // arrives at most a fraction of a percent of the smaller diagonal deep per substep (the
+      // world's arrival rule), so an exit kMaxDetourRel deeper than the nearest one is not where it
+      // came in: an open bunny's rim vertex, whose normal lies along the floor, faced the box's side
+      // face 0.3-2 m away, and the bunny was pushed sideways into the box (a drop ended 16 % of its
+      // diagonal inside).
+      const double detour = kMaxDetourRel * std::min(patch.body.diagonal(), faceted.body.diagonal());
+      if (pressed == faces.size() || depth > nearestDepth + detour) pressed = nearest, depth = nearestDepth;
+      const Vec3& exit = halfSpaces[pressed].first;
+      Contact ci = c;
+      ci.normal = facetedIsB ? exit : Vec3(-exit);
+      ci.point = v + 0.5 * depth * exit;
+      ci.depth = depth;
+      // Exact only against the whole body's faces: "behind every face plane of a leaf's patch" is
+      // no proof of being inside (an icosphere's leaf holds a few of its 320 faces; a vertex
+      // behind them may lie outside the body), so there the pair's bound stays (measured:
+      // tests/narrowphase/error_bound_test.cpp, docs/narrow-phase.md "Error bounds").
+      ci.errorBound = whole ? 0.0 : c.errorBound;
+      out.push_back(ci);
     }
-    if (!inside) continue;
-    // No face it faces, or one much deeper than the nearest face: the nearest face. A vertex
-    // arrives at most a fraction of a percent of the smaller diagonal deep per substep (the
-    // world's arrival rule), so an exit kMaxDetourRel deeper than the nearest one is not where it
-    // came in: an open bunny's rim vertex, whose normal lies along the floor, faced the box's side
-    // face 0.3-2 m away, and the bunny was pushed sideways into the box (a drop ended 16 % of its
-    // diagonal inside).
-    const double detour = kMaxDetourRel * std::min(patch.body.diagonal(), faceted.body.diagonal());
-    if (pressed == faces.size() || depth > nearestDepth + detour) pressed = nearest, depth = nearestDepth;
-    const Vec3& exit = halfSpaces[pressed].first;
-    Contact ci = c;
-    ci.normal = facetedIsB ? exit : Vec3(-exit);
-    ci.point = v + 0.5 * depth * exit;
-    ci.depth = depth;
-    // Exact only against the whole body's faces: "behind every face plane of a leaf's patch" is
-    // no proof of being inside (an icosphere's leaf holds a few of its 320 faces; a vertex
-    // behind them may lie outside the body), so there the pair's bound stays (measured:
-    // tests/narrowphase/error_bound_test.cpp, docs/narrow-phase.md "Error bounds").
-    ci.errorBound = whole ? 0.0 : c.errorBound;
-    out.push_back(ci);
   }
   return out.size() > before;
 }

@@ -130,6 +130,28 @@ TEST(ExperimentFlatContactCli, ReferenceBoxRisesOverTheBumpButNotOnFlatGround) {
   EXPECT_LT(reference["flat_max_lift_mm"].get<double>(), 0.25 * bumpHeight * 1e3);
 }
 
+// Issue 17, point 4: cfm's box follows the reference (the exact model) over the bump. The first
+// second (--quick) is the approach and the climb, where cfm went wrong: the ground patch offered
+// only its hull's vertices, so the bump's flank under the box's front edge gave no contact; the
+// box ploughed in until the bump's top was ~4 cm inside and was thrown up or stopped, turned
+// (3 starts: 105 mm rms, heading error 4.2 deg; now 28 mm and 0.14 deg). Bounds: the issue's
+// 50 mm and 1 deg, which the reference itself keeps against a 1 mm shift of its start (24 mm
+// over the full 2 s, REPRODUCING.md "flat-contact"). Over the full 2 s cfm is at 56 mm: not held.
+TEST(ExperimentFlatContactCli, CfmFollowsTheReferenceUpTheBump) {
+  if (clod::test::sanitizerRun()) GTEST_SKIP() << "contact-tree simulations: the Release run covers this test";
+  const clod::test::CliRun run = runCli("experiment flat-contact --quick --trials 3 --json");
+  ASSERT_EQ(run.exitCode, 0) << run.err;
+  const auto doc = nlohmann::json::parse(run.out);
+  bool found = false;
+  for (const auto& row : doc["bump"]) {
+    if (row["model"] != "cfm") continue;
+    found = true;
+    EXPECT_LT(row["rms_position_error_mm"].get<double>(), 50.0);
+    EXPECT_LT(row["max_yaw_error_deg"].get<double>(), 1.0);
+  }
+  EXPECT_TRUE(found);
+}
+
 TEST(ExperimentFlatContactCli, BadTrialsExitWithTwo) {
   clod::test::CliRun run = runCli("experiment flat-contact --trials 500");
   EXPECT_EQ(run.exitCode, 2);

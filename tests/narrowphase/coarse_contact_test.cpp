@@ -396,4 +396,107 @@ TEST(CoarseContacts, CurvedPatchesApartAlongTheCentreLineGiveNoContact) {
   EXPECT_GE(touching, 20);
 }
 
+
+// A closed slab whose top (z = 0) is a height field with a smooth bump h(r) = H (1 + cos(pi r /
+// R)) / 2 for r < R around (bx, 0): 2 cm cells within the bump's square, 10 cm elsewhere, side
+// walls and a bottom fanned from its centre; counter-clockwise seen from outside.
+TriangleMesh makeBumpedSlab(double halfX, double halfY, double bx, double height, double radius) {
+  auto lines = [](double lo, double hi, double c, double r) {
+    std::vector<double> v;
+    for (double x = lo; x < c - r - 1e-9; x += 0.1) v.push_back(x);
+    for (double x = c - r; x < c + r - 1e-9; x += 0.02) v.push_back(x);
+    for (double x = c + r; x < hi - 1e-9; x += 0.1) v.push_back(x);
+    v.push_back(hi);
+    std::vector<double> out;
+    for (double x : v)
+      if (out.empty() || x - out.back() > 0.005) out.push_back(x);
+    out.back() = hi;
+    return out;
+  };
+  const std::vector<double> xs = lines(-halfX, halfX, bx, radius), ys = lines(-halfY, halfY, 0.0, radius);
+  const auto nx = static_cast<std::uint32_t>(xs.size()), ny = static_cast<std::uint32_t>(ys.size());
+  TriangleMesh mesh;
+  auto top = [&](std::uint32_t i, std::uint32_t j) { return j * nx + i; };
+  for (std::uint32_t j = 0; j < ny; ++j) {
+    for (std::uint32_t i = 0; i < nx; ++i) {
+      const double r = std::hypot(xs[i] - bx, ys[j]);
+      mesh.vertices.emplace_back(xs[i], ys[j], r < radius ? 0.5 * height * (1.0 + std::cos(kPi * r / radius)) : 0.0);
+    }
+  }
+  for (std::uint32_t j = 0; j + 1 < ny; ++j) {
+    for (std::uint32_t i = 0; i + 1 < nx; ++i) {
+      mesh.triangles.push_back({top(i, j), top(i + 1, j), top(i + 1, j + 1)});
+      mesh.triangles.push_back({top(i, j), top(i + 1, j + 1), top(i, j + 1)});
+    }
+  }
+  std::vector<std::uint32_t> ring;  // the top's boundary, counter-clockwise seen from +z
+  for (std::uint32_t i = 0; i + 1 < nx; ++i) ring.push_back(top(i, 0));
+  for (std::uint32_t j = 0; j + 1 < ny; ++j) ring.push_back(top(nx - 1, j));
+  for (std::uint32_t i = nx - 1; i > 0; --i) ring.push_back(top(i, ny - 1));
+  for (std::uint32_t j = ny - 1; j > 0; --j) ring.push_back(top(0, j));
+  const auto bottom0 = static_cast<std::uint32_t>(mesh.vertices.size());
+  for (std::uint32_t v : ring) mesh.vertices.emplace_back(mesh.vertices[v].x(), mesh.vertices[v].y(), -0.5);
+  const auto centre = static_cast<std::uint32_t>(mesh.vertices.size());
+  mesh.vertices.emplace_back(0.0, 0.0, -0.5);
+  const auto n = static_cast<std::uint32_t>(ring.size());
+  for (std::uint32_t k = 0; k < n; ++k) {
+    const std::uint32_t k1 = (k + 1) % n;
+    mesh.triangles.push_back({bottom0 + k, bottom0 + k1, ring[k1]});
+    mesh.triangles.push_back({bottom0 + k, ring[k1], ring[k]});
+    mesh.triangles.push_back({centre, bottom0 + k1, bottom0 + k});
+  }
+  return mesh;
+}
+
+// A unit cube resting on a bumped ground (a 4 cm bump of radius 20 cm, the ground of `clod
+// experiment flat-contact`), 0.5 mm into its flat part, with its front face over the bump's
+// flank (the bump's top still outside the box) or over its top. Oracle: every ground vertex,
+// checked one by one against the box (brute force); its depth is its height above the box's
+// bottom face. cfm must give the deepest of them as a contact at its own depth. Before, a
+// curved patch of the ground offered only its convex hull's vertices -- the bump's top and the
+// patch's rim -- so the flank under the box's edge gave no contact, the box ploughed into the
+// bump and was thrown up when the top arrived (flat-contact: 239 mm rms from the exact track).
+TEST(CoarseContacts, BoxOverABumpsFlankGetsTheDeepestGroundVertexAsAContact) {
+  const double bx = 0.6, bumpHeight = 0.04, bumpRadius = 0.2, sunk = 0.0005;
+  static const CollisionBody ground = [&] {
+    BakeSettings settings;
+    settings.sphereTree.method = SphereTreeMethod::kOctree;
+    settings.sphereTree.depth = 3;
+    settings.measureFit = false;
+    settings.buildContactTree = false;
+    return CollisionBody::fromBake(bakeMesh(makeBumpedSlab(1.6, 1.0, bx, bumpHeight, bumpRadius), settings).contents);
+  }();
+  const CollisionBody& cube = slabBodies().cube;
+  // Rounding of face planes from float face normals over a few metres, relative to the ground's
+  // diagonal (~3.8 m): 1e-6 of it is far below the millimetres the test tells apart.
+  const double rounding = 1e-6 * ground.diagonal();
+  int cases = 0;
+  // Front face at r = 0.14, 0.1, 0.06 before the bump's centre (the top outside the box), and
+  // past it (the top under the face).
+  for (double front : {bx - 0.14, bx - 0.1, bx - 0.06, bx + 0.1}) {
+    const Pose pose{Quat::Identity(), Vec3(front - 0.5, 0.05, 0.5 - sunk)};
+    double deepest = 0.0;
+    for (const Vec3& v : ground.mesh().vertices) {
+      const Vec3 local = pose.applyInverse(v);
+      if ((local.array().abs() < 0.5).all()) deepest = std::max(deepest, local.z() + 0.5);
+    }
+    ASSERT_GT(deepest, 4.0 * sunk) << "front " << front << ": the bump's flank is under the box";
+    for (bool groundIsA : {true, false}) {
+      QuerySettings settings;  // unlimited budget: the ground's leaves against the box
+      settings.model = ContactModel::kCfm;
+      const QueryResult r = groundIsA ? queryContacts(ground, Pose{}, cube, pose, settings)
+                                      : queryContacts(cube, pose, ground, Pose{}, settings);
+      const std::string what = "front " + std::to_string(front) + (groundIsA ? ", ground is A" : ", ground is B");
+      double deepestContact = 0.0;
+      for (const Contact& c : r.contacts) {
+        // Normal from B to A: up when the box is A.
+        EXPECT_LT(angleBetween(groundIsA ? Vec3(-c.normal) : c.normal, Vec3::UnitZ()), 1e-6) << what;
+        deepestContact = std::max(deepestContact, c.depth);
+      }
+      EXPECT_NEAR(deepestContact, deepest, rounding) << what;
+      ++cases;
+    }
+  }
+  EXPECT_EQ(cases, 8);
+}
 }  // namespace clod
