@@ -211,8 +211,7 @@ struct ContactTree {
   }
   /// Interpolation error bound of the node's cell, in mesh units: the largest |trilinear -
   /// exact| measured at the cell's test points times the gap factor (docs/contact-tree.md:
-  /// 3x3x3 lattice + 8 octant centres, times 2; or, for a cell that took the builder's second
-  /// look, the 5x5x5 grid, times 1.5), or, for a cell the builder proved far from the surface
+  /// 3x3x3 lattice + 8 octant centres), or, for a cell the builder proved far from the surface
   /// without measuring, the Lipschitz bound of half the cell diagonal (plus the value rounding
   /// q/2, see valueStep()), which holds everywhere in the cell for any 1-Lipschitz field;
   /// never more than that, except in cells where the field

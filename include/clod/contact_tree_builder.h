@@ -3,11 +3,9 @@
 //
 // The octree covers the mesh's bounding box enlarged by cubeMarginRel * diagonal on every side,
 // made cubic. A cell is refined while the trilinear interpolation of its corner values differs
-// from the exact signed distance by more than errorRel * diagonal / 2 at any of its 27 test
-// points that lie in the band |d| <= bandRel * diagonal (+ half the cell size, so every band
-// point is near a counted test point) -- the factor 2 allows for peaks between the points --
-// and maxDepth is not reached; a cell that misses only by that factor gets a second look on
-// the 5x5x5 grid (factor 1.5 there) and may stay a leaf. Cells whose corners prove (by the
+// from the exact signed distance by more than errorRel * diagonal at any of its test points that
+// lie in the band |d| <= bandRel * diagonal (+ half the cell size, so every band point is near
+// a counted test point), and maxDepth is not reached. Cells whose corners prove (by the
 // 1-Lipschitz property of a distance) that no point of the cell is within the band are not
 // measured and not refined. docs/contact-tree.md has the argument for every threshold.
 //

@@ -27,12 +27,6 @@ constexpr double kSqrt3 = 1.7320508075688772;
 // the refinement test (measured <= eps / kGapFactor) and for the stored bound (kGapFactor *
 // measured, capped by the rigorous half-diagonal). docs/contact-tree.md has the measurements.
 constexpr double kGapFactor = 2.0;
-// A cell whose 27 test points ask for a split only because of the gap factor (measured band
-// error in (eps / kGapFactor, eps / kDenseGapFactor]) gets a second look on the 5x5x5 grid of
-// spacing h/4 (98 more points, covering radius 0.22 h): a kink between those points peaks at
-// most ~1.33x above its nearest samples (a tent of half-width h/4 sampled h/16 off its top), so
-// the factor there is 1.5. Most such cells are smooth and stay leaves (docs/contact-tree.md).
-constexpr double kDenseGapFactor = 1.5;
 
 // A cell waiting to be processed: where it is, its corner values as stored (rounded to the
 // value step q, ContactTree::valueStep) and as measured (float-rounded exact values: the
@@ -241,39 +235,11 @@ void Builder::measureCell(const PendingCell& cell, std::uint32_t depth, double* 
     if (kLatticeSlot[l] >= 0) account(0.5 * Vec3(l % 3, (l / 3) % 3, l / 9), exact[l]);
   // The octant centres only matter when the lattice alone does not already demand a split
   // (they become the children's centres and are measured there anyway).
-  std::array<double, 8> octantExact{};
-  bool octantsMeasured = false;
   if (!(kGapFactor * bandError > tree_.errorAbs && depth < settings_.maxDepth)) {
-    octantsMeasured = true;
     for (int o = 0; o < 8; ++o) {
       const Vec3 t(0.25 + 0.5 * (o & 1), 0.25 + 0.5 * ((o >> 1) & 1), 0.25 + 0.5 * ((o >> 2) & 1));
-      octantExact[o] = exactAt(t);
-      account(t, octantExact[o]);
+      account(t, exactAt(t));
     }
-  }
-  // Second look (kDenseGapFactor): the 5x5x5 grid of spacing h/4, which holds the lattice and
-  // the octant centres. A band point is within 0.22 h of a grid point, so a grid point counts
-  // for the band if |d| <= band + h/4. Only where the 27 points alone cannot settle it.
-  bool dense = false;
-  double denseError = 0.0, denseBandError = 0.0;
-  if (kGapFactor * bandError > tree_.errorAbs && kDenseGapFactor * bandError <= tree_.errorAbs && depth < settings_.maxDepth) {
-    dense = true;
-    const double denseBandTest = band + 0.25 * h;
-    for (int k = 0; k <= 4; ++k)
-      for (int j = 0; j <= 4; ++j)
-        for (int i = 0; i <= 4; ++i) {
-          const Vec3 t(0.25 * i, 0.25 * j, 0.25 * k);
-          double value;
-          if (i % 2 == 0 && j % 2 == 0 && k % 2 == 0)
-            value = exact[i / 2 + 3 * (j / 2) + 9 * (k / 2)];
-          else if (octantsMeasured && i % 2 == 1 && j % 2 == 1 && k % 2 == 1)
-            value = octantExact[(i / 2) + 2 * (j / 2) + 4 * (k / 2)];
-          else
-            value = exactAt(t);
-          const double e = std::abs(interpolateTrilinear(cell.corners, t, nullptr) - value);
-          denseError = std::max(denseError, e);
-          if (std::abs(value) <= denseBandTest) denseBandError = std::max(denseBandError, e);
-        }
   }
 
   // A distance is 1-Lipschitz; lattice neighbours (h/2 apart) differing by more reveal a sign
@@ -288,9 +254,8 @@ void Builder::measureCell(const PendingCell& cell, std::uint32_t depth, double* 
 
   // Measured values cannot exceed the rigorous Lipschitz bound unless the field jumps.
   const double step = detail::latticeStep(tree_, depth);
-  const double measuredBound = dense ? kDenseGapFactor * denseError : kGapFactor * error;
-  r.error = static_cast<float>(r.discontinuous ? measuredBound : std::min(measuredBound, 0.5 * (diagonal + step)));
-  r.bandError = static_cast<float>(dense ? denseBandError : bandError);
+  r.error = static_cast<float>(r.discontinuous ? kGapFactor * error : std::min(kGapFactor * error, 0.5 * (diagonal + step)));
+  r.bandError = static_cast<float>(bandError);
   // Stored as the bake file stores them: prediction from the corners + a multiple of q.
   for (int l = 0; l < kLatticeSize; ++l) {
     r.latticeExact[l] = static_cast<float>(exact[l]);
@@ -310,7 +275,7 @@ void Builder::measureCell(const PendingCell& cell, std::uint32_t depth, double* 
   const double dc = centre.signedDistance;
   const bool canSplit = depth < settings_.maxDepth &&
                         (!r.discontinuous || diagonal > settings_.discontinuityStopRel * tree_.meshDiagonal);
-  const bool overError = dense ? kDenseGapFactor * denseBandError > tree_.errorAbs : kGapFactor * bandError > tree_.errorAbs;
+  const bool overError = kGapFactor * bandError > tree_.errorAbs;
   r.split = overError && canSplit;
   r.aboveError = !r.split && overError && !r.discontinuous;
 
