@@ -302,6 +302,11 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
       for (int layer = 0; layer < layers; ++layer) {
         Vec3 pS = onSurface - (layer * settings.offSurfaceDepthRel * hMin) * surface.normal;
         if (!insideCell(treeS, cellS, pS)) continue;
+        // The layer below the surface must lie in S: half a coarse cell below one face of a thin
+        // body is past its far face (a 0.45 m box's root cell is 1.1 m), where O's field would
+        // report a phantom penetration -- a box resting on a slab got 5-10 cm deep contacts
+        // from points outside it, was lifted and tipped 14 degrees.
+        if (layer > 0 && !(treeS.sample(pS, settings.maxDepth).distance < 0.0)) continue;
         Vec3 pWorld = xfWorldFromS.apply(pS);
         Vec3 pO = xfWorldFromO.applyInverse(pWorld);
         if (!insideCell(treeO, cellO, pO)) continue;

@@ -120,6 +120,28 @@ struct PairState {
 
 std::uint64_t pairKey(BodyId a, BodyId b) { return (std::uint64_t(a) << 32) | b; }
 
+// One friction update of a contact: the tangential impulse that stops the sliding velocity
+// (massT1 * v.t1, massT2 * v.t2 along the two tangents, already scaled by the effective masses)
+// added to the accumulated one, and the sum clamped to the Coulomb cone |lambdaT| <= limit
+// (mu times the normal impulse). Clamping each tangent on its own (a friction pyramid) lets a
+// body sliding diagonally to the tangents feel up to sqrt 2 times mu N, its friction pointing
+// along the diagonal instead of against the velocity: a box sliding at 48 deg to the world axes
+// turned toward an axis, stopped short and tipped over. Returns the impulse change (world).
+template <class Contact>
+Vec3 frictionStep(Contact& cp, double stop1, double stop2, double limit) {
+  const double old1 = cp.lambdaT1, old2 = cp.lambdaT2;
+  double l1 = old1 - stop1, l2 = old2 - stop2;
+  const double length = std::hypot(l1, l2);
+  if (length > limit) {
+    const double scale = limit > 0.0 ? limit / length : 0.0;
+    l1 *= scale;
+    l2 *= scale;
+  }
+  cp.lambdaT1 = l1;
+  cp.lambdaT2 = l2;
+  return (l1 - old1) * cp.t1 + (l2 - old2) * cp.t2;
+}
+
 void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
   // Any unit vector orthogonal to n, chosen from the axis least aligned with n (stable).
   const Vec3 a = std::abs(n.x()) < 0.57735 ? Vec3::UnitX() : (std::abs(n.y()) < 0.57735 ? Vec3::UnitY() : Vec3::UnitZ());
@@ -806,14 +828,9 @@ void World::Impl::solve(double h) {
         upper.v += sign * upper.invMass * impulse;
         upper.w += sign * (upper.invInertiaWorld * r.cross(impulse));
       };
-      const double limit = mu * cp.lambdaN;
-      double old = cp.lambdaT1;
-      cp.lambdaT1 = std::clamp(old - cp.shockMassT1 * relative().dot(cp.t1), -limit, limit);
-      push((cp.lambdaT1 - old) * cp.t1);
-      old = cp.lambdaT2;
-      cp.lambdaT2 = std::clamp(old - cp.shockMassT2 * relative().dot(cp.t2), -limit, limit);
-      push((cp.lambdaT2 - old) * cp.t2);
-      old = cp.lambdaN;
+      const Vec3 vt = relative();
+      push(frictionStep(cp, cp.shockMassT1 * vt.dot(cp.t1), cp.shockMassT2 * vt.dot(cp.t2), mu * cp.lambdaN));
+      double old = cp.lambdaN;
       cp.lambdaN = std::max(0.0, old - cp.shockMassN * (relative().dot(cp.c.normal) + cp.speculative));
       push((cp.lambdaN - old) * cp.c.normal);
     }
@@ -848,18 +865,11 @@ void World::Impl::solve(double h) {
           // Friction first, limited by the current normal impulse; then the normal, so that
           // non-penetration, the more important constraint, is solved last (Catto 2005).
           Vec3 vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
-          const double limit = mu * cp.lambdaN;
-          double old = cp.lambdaT1;
-          cp.lambdaT1 = std::clamp(old - cp.massT1 * vr.dot(cp.t1), -limit, limit);
-          apply(a, b, cp, (cp.lambdaT1 - old) * cp.t1);
-          maxChange = std::max(maxChange, std::abs(cp.lambdaT1 - old));
+          const Vec3 friction = frictionStep(cp, cp.massT1 * vr.dot(cp.t1), cp.massT2 * vr.dot(cp.t2), mu * cp.lambdaN);
+          apply(a, b, cp, friction);
+          maxChange = std::max(maxChange, friction.norm());
           vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
-          old = cp.lambdaT2;
-          cp.lambdaT2 = std::clamp(old - cp.massT2 * vr.dot(cp.t2), -limit, limit);
-          apply(a, b, cp, (cp.lambdaT2 - old) * cp.t2);
-          maxChange = std::max(maxChange, std::abs(cp.lambdaT2 - old));
-          vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
-          old = cp.lambdaN;
+          double old = cp.lambdaN;
           cp.lambdaN = std::max(0.0, old - cp.massN * (vr.dot(cp.c.normal) + cp.speculative));
           apply(a, b, cp, (cp.lambdaN - old) * cp.c.normal);
           maxChange = std::max(maxChange, std::abs(cp.lambdaN - old));

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "clod/contact_normal.h"
+#include "clod/contact_rim.h"
 #include "clod/error.h"
 #include "containment.h"
 #include "face_overlap.h"
@@ -1723,6 +1724,7 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
     }
   }
 
+  bool found = false;  // a containment answer replaced the contacts
   {
     // Containment (docs/narrow-phase.md): one closed body wholly inside the other. Its surfaces
     // meet nothing: the query found no contact, or only loose sphere pairs' ones. A few exact field
@@ -1731,7 +1733,6 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
     // whatever the budget).
     const bool haveContacts = !s.raw.empty();
     const std::size_t first = s.raw.size();
-    bool found = false;
     const std::uint32_t queries = detail::containmentContacts(a, b, xfAFromB, settings.maxContacts, haveContacts,
                                                               s.containment, s.raw, found);
     meter.count(queries);
@@ -1755,6 +1756,16 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
   if (model == ContactModel::kCfm || exactInterrupted) manifold.poolNormalsCos = kPoolNormalsCos;
   const std::size_t kept = reduceManifold(s.raw, manifold, s.manifold);
   result.contacts.assign(s.raw.begin(), s.raw.begin() + static_cast<std::ptrdiff_t>(kept));
+  // The contact tree's lattice samples lie inside the rim of their contact area: push the kept
+  // ones out to it (contact_rim.h), so the manifold has the support polygon the bodies have.
+  // Not counted as tests (like the sampling, the budget buys traversal) and not begun past an
+  // answer deadline.
+  const bool answerTimeLeft = !(settings.budget.deadline != QueryBudget::TimePoint::max() &&
+                                settings.budget.answerWithinDeadline && settings.budget.now() >= settings.budget.deadline);
+  if (cells && !found && kept >= 2 && answerTimeLeft) {
+    extendContactsToRim(a.contactTree(), xfWorldFromA, b.contactTree(), xfWorldFromB, result.contacts,
+                        settings.contactSampling.marginAbs);
+  }
   std::stable_sort(result.contacts.begin(), result.contacts.end(),
                    [](const Contact& x, const Contact& y) { return x.depth > y.depth; });
 
