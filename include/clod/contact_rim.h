@@ -2,12 +2,13 @@
 // Contact-tree manifolds pushed out to the rim of their contact area.
 //
 // The contact tree's contacts are samples on a lattice (contact_sampling.h): the outermost sample
-// of a face-on-face overlap lies up to one spacing inside the overlap's rim, so the manifold's
-// support polygon is smaller than the true one (a 0.45 m wide box sliding on a slab had its
-// contacts 1-3 cm inside its bottom face's edges and tipped over on them). Exact polygon
-// clipping (the exact model) puts them at the corners; here each kept contact walks outward from
-// the manifold's centroid, in its contact plane, for as long as both fields stay as they were at
-// the contact (the point stays on the one surface and under the other), and stops at the rim.
+// of a face-on-face overlap lies up to one spacing inside the overlap's rim, and the manifold
+// reduction keeps a spread of samples, not the corners, so the support polygon is smaller than
+// the true one (two aligned unit cubes: the nearest contact up to 27 cm from a corner of their
+// overlap). Exact polygon clipping (the exact model) puts them at the corners; here each kept
+// contact walks outward from the manifold's centroid, in its contact plane, for as long as both
+// fields stay as they were at the contact (the point stays on the one surface and under the
+// other), then along the rim it met, to a corner.
 
 #include <cstdint>
 #include <span>
@@ -29,15 +30,16 @@ struct ContactRimSettings {
   std::uint32_t halvings = 5;
 };
 
-/// Moves the contacts (world frame, normals from B toward A) outward to the rim of their contact
-/// area, where the contacts form one face-on-face patch (normals within 2 deg, points in one
-/// plane within their depths' spread and eps_s). A probe point q holds when each field is within
-/// half its tree's errorAbs (and 1e-9 of the diagonals) of its value at the contact: the walk neither leaves the surface the contact lies
-/// on nor changes its depth under the other body, so the configuration -- and the depth -- are
-/// the contact's within that error. A moved contact keeps its normal and depth; its error bound
-/// grows by the two fields' change between the contact and where it ends.
-/// Contacts deeper than -marginAbs take part; fewer than two such: nothing moves. Returns the
-/// field queries made (1 + steps + halvings at most per contact).
+/// Moves the contacts (world frame, normals from B toward A) out to the rim of their contact area
+/// and along it, where they form one face-on-face patch: the touching contacts whose normals lie
+/// within 2 deg of the deepest one's walk, if their points lie on two parallel planes (within the
+/// deepest depth and eps_s; the samples lie on either face). A probe point holds when each field
+/// is within half its tree's errorAbs (and 1e-9 of the diagonals) of its value at the contact:
+/// the walk neither leaves the surface the contact lies on nor changes its depth under the other
+/// body. A walk that met a rim steps back by the fields' change there plus that tolerance. A moved
+/// contact keeps its normal and depth; its error bound grows by the fields' change. Contacts
+/// shallower than -marginAbs stay. Returns the field queries made (at most 1 + 2 (steps +
+/// halvings) per contact, each query sampling both trees).
 std::uint32_t extendContactsToRim(const ContactTree& a, const Pose& xfWorldFromA, const ContactTree& b,
                                   const Pose& xfWorldFromB, std::span<Contact> contacts, double marginAbs,
                                   const ContactRimSettings& settings = {});

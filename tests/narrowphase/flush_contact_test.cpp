@@ -206,5 +206,29 @@ TEST(FlushContact, ContactTreeDoesNotPushAlongFlushFaces) {
   }
 }
 
+// The contact tree's manifold spans the overlap (contact_rim.h): its lattice samples lie inside
+// the rim and the manifold reduction keeps a spread of them, not the corners; the kept ones walk
+// out to the rim and along it. At every budget each corner of the analytic overlap has a contact
+// within six leaves of the tree (5 cm) in the contact plane. Why six: the walk ends where a field
+// has changed by half its tree's eps_s, and near a box's edges the trilinear cells round the
+// edge over a few leaves (measured 1.2-3.2 cm); without the walk the nearest contact lay up to
+// 27 cm from a corner.
+TEST(FlushContact, ContactTreeManifoldReachesTheCornersOfAFaceOnFaceOverlap) {
+  const Bodies& b = bodies();
+  const double leaf = b.unit.contactTree().cellSize(b.unit.contactTree().maxDepth);
+  for (const Configuration& config : configurations()) {
+    if (config.smallA || !config.faceNormal || config.corners.size() != 4) continue;
+    for (std::uint64_t budget : {std::uint64_t(16), std::uint64_t(256), kUnlimitedTests}) {
+      const std::string what = config.name + ", contact-tree at " + std::to_string(budget);
+      const QueryResult r = queryContacts(b.unit, config.poseA, b.unit, bPose(config),
+                                          settingsFor(ContactModel::kContactTree, budget));
+      dump(what, r);
+      for (const Vec3& corner : config.corners) {
+        EXPECT_LT(nearestInPlane(r, corner), 6.0 * leaf) << what << ": corner " << corner.transpose();
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace clod
