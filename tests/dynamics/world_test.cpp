@@ -154,26 +154,35 @@ TEST(World, BoxDroppedFlatComesToRestFlatWithEveryModelAndBudget) {
   }
 }
 
+// A world with the given contact model and one static ground body at `pose`.
+World worldOnAGround(ContactModel model, const std::shared_ptr<const CollisionBody>& shape, double friction,
+                     const Pose& pose) {
+  WorldSettings ws;
+  ws.model = model;
+  World world(ws);
+  RigidBodyDesc ground;
+  ground.shape = shape;
+  ground.type = BodyType::kStatic;
+  ground.friction = friction;
+  ground.position = pose.translation;
+  ground.orientation = pose.rotation;
+  world.addBody(ground);
+  return world;
+}
+
 // Coulomb friction is a cone: a box sliding on a slab, whatever its direction to the world
 // axes, slows at mu g against its velocity and stops after v^2 / (2 mu g) in a straight line.
 // (A friction pyramid -- each tangent clamped to mu N on its own -- gives up to sqrt 2 mu N
 // along a diagonal, and turns the slide toward an axis: at 30 and 120 deg the end of this
-// slide turned 11.6 deg off the initial direction, at 45 deg it stopped short.) Oracle: the analytic distance and the initial direction.
+// slide turned 11.6 deg off the initial direction, at 45 deg it stopped short.) Oracle: the
+// analytic distance and the initial direction.
 TEST(World, BoxSlidingDiagonallyToTheAxesStopsAfterVSquaredOverTwoMuGInAStraightLine) {
   const auto slab = bakeShape(makeBox(Vec3(3.0, 3.0, 0.25)));
   constexpr double kMu = 0.5, kSpeed = 2.0, kGravity = 9.81;
   const double expected = kSpeed * kSpeed / (2.0 * kMu * kGravity);  // 0.408 m
   for (ContactModel model : {ContactModel::kCfm, ContactModel::kExact}) {
     for (double angleDeg : {30.0, 45.0, 120.0}) {
-      WorldSettings ws;
-      ws.model = model;
-      World world(ws);
-      RigidBodyDesc ground;
-      ground.shape = slab;
-      ground.type = BodyType::kStatic;
-      ground.friction = kMu;
-      ground.position = Vec3(0.0, 0.0, -0.25);
-      world.addBody(ground);
+      World world = worldOnAGround(model, slab, kMu, Pose{Quat::Identity(), Vec3(0.0, 0.0, -0.25)});
       RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
       box.friction = kMu;
       box.position = Vec3(0.0, 0.0, 0.5);
@@ -208,15 +217,7 @@ TEST(World, BoxSlidingDownASlopeCoversHalfATSquaredAtSixtyHertz) {
   const Vec3 up = slope * Vec3::UnitZ(), downhill = slope * Vec3::UnitX();
   const double a = kGravity * (std::sin(kSlopeDeg * M_PI / 180.0) - kMu * std::cos(kSlopeDeg * M_PI / 180.0));
   for (ContactModel model : {ContactModel::kCfm, ContactModel::kExact}) {
-    WorldSettings ws;
-    ws.model = model;
-    World world(ws);
-    RigidBodyDesc ground;
-    ground.shape = slab;
-    ground.type = BodyType::kStatic;
-    ground.friction = kMu;
-    ground.orientation = slope;
-    world.addBody(ground);
+    World world = worldOnAGround(model, slab, kMu, Pose{slope, Vec3::Zero()});
     RigidBodyDesc box = dynamicBox(unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
     box.friction = kMu;
     box.orientation = slope;
