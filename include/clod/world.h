@@ -13,6 +13,7 @@
 //   2. per substep: gravity; broad phase (sweep and prune over world boxes of the root spheres);
 //      budget division among the candidate pairs (below); narrow phase (queryContacts) per pair;
 //      velocity solve (normal + 2 friction directions per contact, accumulated impulses clamped,
+//      friction to the Coulomb cone,
 //      warm started from the previous substep's contacts of the same pair, matched one-to-one by
 //      proximity and normal; pairs solved in a fixed order of body ids). Contacts persist: each is
 //      anchored in both bodies, a matched one keeps its anchors while they have not slid or opened
@@ -25,7 +26,9 @@
 //      restitution only above WorldSettings::restitutionThreshold; penetration removed by a
 //      separate pseudo-velocity solve (split impulses) that moves positions but never enters the
 //      velocities, so correction adds no kinetic energy; integration (semi-implicit Euler for
-//      positions; angular momentum kept exactly through rotation, see docs/dynamics.md).
+//      positions along pressing contacts' normals and in free flight, the trapezoid rule along
+//      the other directions of a pressed body; angular momentum kept exactly through rotation,
+//      see docs/dynamics.md).
 //
 // Budget division (the time-critical part): WorldSettings::budgetTests is per step (frame). A
 // substep may spend ceil(tests the step has left / substeps left). Within a substep the
