@@ -364,6 +364,7 @@ void checkText(std::string_view text, std::string_view format, const std::string
     if (auto problem = detail::findJsonDepthProblem(*json, options.maxJsonDepth))
       throw Error(ErrorCode::kParseError, source + ": " + *problem);
   }
+  if (auto problem = detail::findColladaNumberListProblem(text)) throw Error(ErrorCode::kParseError, source + ": " + *problem);
   detail::checkDeclaredCounts(text, format, source, options);
 }
 
@@ -408,10 +409,11 @@ LoadedMesh loadMesh(const std::filesystem::path& path, const MeshLoadOptions& op
   }
   std::string format = lowercase(path.extension().string());
   if (!format.empty()) format.erase(0, 1);
-  // The bytes of OBJ, OFF, PLY, glTF and GLB files are needed (text_index_check.h, off_reader.h).
+  // The bytes of OBJ, OFF, PLY, glTF, GLB and Collada files are needed (text_index_check.h,
+  // off_reader.h).
   // Assimp sniffs content whatever the extension, so every file's first bytes are looked at.
   std::string text;
-  if (format == "obj" || format == "off" || format == "ply" || format == "glb" || format == "gltf") {
+  if (format == "obj" || format == "off" || format == "ply" || format == "glb" || format == "gltf" || format == "dae") {
     text = readWholeFile(path);
   } else {
     char head[64] = {};
@@ -421,8 +423,10 @@ LoadedMesh loadMesh(const std::filesystem::path& path, const MeshLoadOptions& op
       const std::string_view headText(head, n);
       // All whitespace: it may still be JSON further on (glTF is recognised by content too).
       const bool blank = headText.find_first_not_of(" \t\r\n") == std::string_view::npos;
+      // XML may be Collada, which Assimp recognises by content too.
+      const bool xml = headText.find("<?xml") != std::string_view::npos || detail::looksLikeCollada(headText);
       if (detail::looksLikePly(headText) || detail::looksLikeGlb(headText) || detail::looksLikeJson(headText) ||
-          blank || useOffReader(format, headText))
+          blank || xml || useOffReader(format, headText))
         text = readWholeFile(path);
     }
   }

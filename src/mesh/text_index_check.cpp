@@ -1,6 +1,9 @@
 #include "text_index_check.h"
 
+#include <algorithm>
+#include <cctype>
 #include <charconv>
+#include <iterator>
 #include <cstring>
 #include <vector>
 
@@ -155,6 +158,40 @@ std::optional<std::string> findJsonDepthProblem(std::string_view json, std::uint
                "; MeshLoadOptions::maxJsonDepth)";
     } else if ((c == ']' || c == '}') && depth > 0) {
       --depth;
+    }
+  }
+  return std::nullopt;
+}
+
+bool looksLikeCollada(std::string_view text) { return text.find("<COLLADA") != std::string_view::npos; }
+
+std::optional<std::string> findColladaNumberListProblem(std::string_view text) {
+  if (!looksLikeCollada(text)) return std::nullopt;
+  static constexpr std::string_view kLists[] = {"p", "vcount", "v", "h", "int_array", "float_array"};
+  // Index lists hold integers; only <float_array> holds reals.
+  auto numberChar = [](char c, bool real) {
+    if ((c >= '0' && c <= '9') || c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '-') return true;
+    return real && (c == '+' || c == '.' || c == 'e' || c == 'E');
+  };
+  for (std::size_t at = text.find('<'); at != std::string_view::npos; at = text.find('<', at + 1)) {
+    std::size_t nameEnd = at + 1;
+    while (nameEnd < text.size() && (std::isalnum(static_cast<unsigned char>(text[nameEnd])) || text[nameEnd] == '_'))
+      ++nameEnd;
+    const std::string_view name = text.substr(at + 1, nameEnd - at - 1);
+    if (std::find(std::begin(kLists), std::end(kLists), name) == std::end(kLists)) continue;
+    if (nameEnd < text.size() && text[nameEnd] != '>' && !std::isspace(static_cast<unsigned char>(text[nameEnd])) &&
+        text[nameEnd] != '/')
+      continue;
+    const std::size_t tagEnd = text.find('>', nameEnd);
+    if (tagEnd == std::string_view::npos) return std::nullopt;  // truncated: Assimp's verdict
+    if (text[tagEnd - 1] == '/') continue;                      // an empty element
+    const bool real = name == "float_array";
+    for (std::size_t k = tagEnd + 1; k < text.size() && text[k] != '<'; ++k) {
+      if (!numberChar(text[k], real)) {
+        return "Collada <" + std::string(name) + "> at byte " + std::to_string(at) +
+               " holds a character that is not part of a number (byte " + std::to_string(k) + ", code " +
+               std::to_string(static_cast<unsigned char>(text[k])) + ")";
+      }
     }
   }
   return std::nullopt;

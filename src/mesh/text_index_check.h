@@ -4,7 +4,8 @@
 // returns (PLY: a header without an `end_header` line loops forever in Assimp 5.2.5).
 // (OFF is not read by Assimp at all: see off_reader.h.) The binary glTF header check lives here
 // too: Assimp allocates and clears whatever chunk length a GLB header claims (1 GiB for a
-// 788-byte file found by fuzz_mesh_load) before it notices the file is shorter.
+// 788-byte file found by fuzz_mesh_load) before it notices the file is shorter. Collada too: a
+// letter in a number list (`<p>0 4 x 2</p>`) makes Assimp's Collada reader spin forever.
 // These scanners read only what they need; they are not loaders, and on anything they do not
 // understand they return std::nullopt and leave the verdict to Assimp.
 
@@ -49,5 +50,16 @@ std::optional<std::string_view> glbJsonChunk(std::string_view bytes);
 /// nesting overflows the stack (200,000 '[' in a 400 kB .gltf crashed `clod inspect`).
 /// A linear scan counting '[' and '{' outside strings: it does not validate the JSON. O(size).
 std::optional<std::string> findJsonDepthProblem(std::string_view json, std::uint32_t maxDepth);
+
+/// True when the text holds a `<COLLADA` element (Assimp recognises Collada by content).
+bool looksLikeCollada(std::string_view text);
+
+/// For Collada content, a message when a number list -- the contents of `<p>`, `<vcount>`,
+/// `<v>`, `<h>`, `<int_array>` or `<float_array>` -- holds a character no number of the list is
+/// written with (digits, whitespace, '-'; in `<float_array>` also '+', '.', 'e', 'E'), naming
+/// the element and the byte; nullopt
+/// otherwise. Assimp 5.2.5's Collada reader never returns on such a list (fuzz_mesh_load:
+/// one byte of box_z_up.dae's `<p>` changed). O(size).
+std::optional<std::string> findColladaNumberListProblem(std::string_view text);
 
 }  // namespace clod::detail
