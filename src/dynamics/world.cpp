@@ -127,8 +127,7 @@ std::uint64_t pairKey(BodyId a, BodyId b) { return (std::uint64_t(a) << 32) | b;
 // body sliding diagonally to the tangents feel up to sqrt 2 times mu N, its friction pointing
 // along the diagonal instead of against the velocity: a box sliding at 48 deg to the world axes
 // turned toward an axis, stopped short and tipped over. Returns the impulse change (world).
-template <class Contact>
-Vec3 frictionStep(Contact& cp, double stop1, double stop2, double limit) {
+Vec3 frictionStep(SolverContact& cp, double stop1, double stop2, double limit) {
   const double old1 = cp.lambdaT1, old2 = cp.lambdaT2;
   double l1 = old1 - stop1, l2 = old2 - stop2;
   const double length = std::hypot(l1, l2);
@@ -1092,9 +1091,8 @@ void World::Impl::collectPressedNormals() {
 
 // Positions of a body that some contact presses: semi-implicit Euler (x += v_new h) along the
 // normals of the contacts that press it -- the velocity the solver made consistent with them --
-// and the trapezoid
-// x += (v_old + v_new) h / 2 along every other direction, where the velocity changed under
-// gravity, forces and friction alone: a constant acceleration then gives the exact a t^2 / 2
+// and the trapezoid x += (v_old + v_new) h / 2 along every other direction, where the velocity
+// changed under gravity, forces and friction alone: a constant acceleration then gives the exact a t^2 / 2
 // instead of a t^2 / 2 + a t h / 2. (That overshoot, 13.5 mm after 2 s down issue 17's 35 deg
 // slope at 60 Hz, is larger than the budget's effect on the slide: a run with more narrow-phase
 // time, closer to the integrator's answer, ended farther from the analytic one.) Along a pressing
@@ -1107,9 +1105,11 @@ void World::Impl::integrate(double h) {
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     Body& b = bodies[i];
     if (b.type == BodyType::kStatic) continue;
-    Vec3 change = b.v - substepStartVelocity[i];
-    for (std::uint8_t k = 0; k < pressedNormalCount[i]; ++k) change -= change.dot(pressedNormals[i][k]) * pressedNormals[i][k];
-    if (b.type != BodyType::kDynamic || pressedNormalCount[i] == 0) change.setZero();
+    Vec3 change = Vec3::Zero();  // the velocity change along the unpressed directions
+    if (b.type == BodyType::kDynamic && pressedNormalCount[i] > 0) {
+      change = b.v - substepStartVelocity[i];
+      for (std::uint8_t k = 0; k < pressedNormalCount[i]; ++k) change -= change.dot(pressedNormals[i][k]) * pressedNormals[i][k];
+    }
     b.x += (b.v + b.vp - 0.5 * change) * h;
     const Vec3 w = b.w + b.wp;
     const Vec3 lWorld = b.type == BodyType::kDynamic ? Vec3(b.q * (b.inertiaLocal * (b.q.conjugate() * b.w))) : Vec3::Zero();

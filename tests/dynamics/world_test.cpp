@@ -47,11 +47,15 @@ RigidBodyDesc dynamicBox(const std::shared_ptr<const CollisionBody>& shape, cons
 }
 
 // A static body (the ground every drop test lands on).
-void addStaticGround(World& world, const std::shared_ptr<const CollisionBody>& shape, const std::string& name = "") {
+void addStaticGround(World& world, const std::shared_ptr<const CollisionBody>& shape, const std::string& name = "",
+                     double friction = RigidBodyDesc{}.friction, const Pose& pose = Pose{}) {
   RigidBodyDesc ground;
   ground.name = name;
   ground.shape = shape;
   ground.type = BodyType::kStatic;
+  ground.friction = friction;
+  ground.position = pose.translation;
+  ground.orientation = pose.rotation;
   world.addBody(ground);
 }
 
@@ -160,13 +164,7 @@ World worldOnAGround(ContactModel model, const std::shared_ptr<const CollisionBo
   WorldSettings ws;
   ws.model = model;
   World world(ws);
-  RigidBodyDesc ground;
-  ground.shape = shape;
-  ground.type = BodyType::kStatic;
-  ground.friction = friction;
-  ground.position = pose.translation;
-  ground.orientation = pose.rotation;
-  world.addBody(ground);
+  addStaticGround(world, shape, "", friction, pose);
   return world;
 }
 
