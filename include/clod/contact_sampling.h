@@ -74,6 +74,11 @@ struct ContactSamplingSettings {
   /// field alone is "rounded" at crossing edges and tilts up to 45 degrees toward one of the
   /// faces. Costs 16 extra field queries per such sample.
   bool edgeEdgeNormals = true;
+  /// Also test the support points of coarse cells (cell_support.h) where a pair has an inner
+  /// cell: for an interrupted query's frontier, whose lattice misses contact regions smaller
+  /// than its spacing. The query sets it when its traversal stopped at the budget; a finished
+  /// traversal's final cells are sampled as before.
+  bool supportPoints = false;
   /// Depth limit for field queries and traversal (kContactTreeLeafDepth: full resolution).
   /// A time-budgeted caller passes a smaller value to stop higher in both trees.
   std::uint32_t maxDepth = kContactTreeLeafDepth;

@@ -40,6 +40,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "clod/math.h"
@@ -159,6 +160,17 @@ struct ContactTree {
   /// deriveFlatSurfaces(), which buildContactTree and decodeContactTree call.
   std::vector<std::uint64_t> flatSurface;
   void deriveFlatSurfaces();
+
+  /// Derived from the mesh (not stored in the bake file; cell_support.h): the support points
+  /// (body frame) of node n's part of the surface are supportPoints[supportOffsets[n] ..
+  /// supportOffsets[n + 1]) for n + 1 < supportOffsets.size(); empty when not derived.
+  std::vector<std::uint32_t> supportOffsets;
+  std::vector<Vec3> supportPoints;
+  /// The support points of `node` (empty beyond the derived depths). O(1).
+  std::span<const Vec3> cellSupports(std::uint32_t node) const {
+    if (std::size_t{node} + 1 >= supportOffsets.size()) return {};
+    return {supportPoints.data() + supportOffsets[node], supportPoints.data() + supportOffsets[node + 1]};
+  }
   /// True when deriveFlatSurfaces() marked `node` flat (false before it ran). O(1).
   bool isFlatSurface(std::uint32_t node) const {
     return (node >> 6) < flatSurface.size() && ((flatSurface[node >> 6] >> (node & 63)) & 1u) != 0;

@@ -113,27 +113,44 @@ struct SurfacePoint {
   double residual;
 };
 
+// The surface data of S at p from S's field there: normal (the gradient), flatness and size of
+// the cell p lies in. False where the gradient vanishes.
+bool describeSurface(const ContactTree& tree, const ContactFieldSample& f, SurfacePoint& at) {
+  const double length = f.gradient.norm();
+  if (!(length > 1e-12)) return false;
+  at.normal = f.gradient / length;
+  const ContactHalfSpace* hs = tree.halfSpace(f.node);
+  at.size = tree.cellSize(f.depth);
+  at.flat = hs && double(hs->fitError) <= kFlatFitRel * at.size;
+  at.residual = std::abs(f.distance);
+  return true;
+}
+
 // Moves p (S frame) onto the zero level of S's field by Newton steps along the gradient (one
 // step lands on a face, a second settles an edge or a corner). False when it does not get within
-// twice the field's error of the surface in three steps (a point near the medial axis, a
-// vanishing gradient): such a lattice point has no surface point to stand for.
+// twice eps_s of the surface in four steps (a point near the medial axis, a vanishing
+// gradient): such a lattice point has no surface point to stand for. The tolerance is eps_s, not
+// the cell's error bound: a coarse cell far from the surface bounds its error by up to half its
+// diagonal, and a point accepted within twice that lay 19 cm off a 1.4 m fandisk -- a contact
+// where the body is not, on which it rocked while its real lowest point sank 12 % of its
+// diagonal into the floor. Newton steps on the interpolant reach its zero level whatever the
+// cells' error.
 bool projectOntoSurface(const ContactTree& tree, std::uint32_t maxDepth, Vec3& p, SurfacePoint& at) {
-  for (int step = 0; step < 3; ++step) {
+  for (int step = 0; step < 4; ++step) {
     const ContactFieldSample f = tree.sample(p, maxDepth);
-    const double length = f.gradient.norm();
-    if (!(length > 1e-12)) return false;
-    at.normal = f.gradient / length;
-    const double tolerance = 2.0 * std::max(tree.errorAbs, f.errorBound);
-    if (std::abs(f.distance) <= tolerance) {
-      const ContactHalfSpace* hs = tree.halfSpace(f.node);
-      at.size = tree.cellSize(f.depth);
-      at.flat = hs && double(hs->fitError) <= kFlatFitRel * at.size;
-      at.residual = std::abs(f.distance);
-      return true;
-    }
-    p -= (f.distance / length) * at.normal;
+    if (!describeSurface(tree, f, at)) return false;
+    if (at.residual <= 2.0 * tree.errorAbs) return true;
+    p -= f.distance * at.normal / f.gradient.norm();
   }
   return false;
+}
+
+// A point of S's mesh (a support point): on the surface by construction, so its residual is 0
+// and the contact's error is O's field's alone.
+bool surfacePointAt(const ContactTree& tree, std::uint32_t maxDepth, const Vec3& p, SurfacePoint& at) {
+  if (!describeSurface(tree, tree.sample(p, maxDepth), at)) return false;
+  at.residual = 0.0;
+  return true;
 }
 
 // An interrupted query's coarse pair spreads its samples evenly over the two cells' overlap,
@@ -146,6 +163,9 @@ bool projectOntoSurface(const ContactTree& tree, std::uint32_t maxDepth, Vec3& p
 // inner non-flat cell each step lands back on S's surface (projectOntoSurface); on a flat one the
 // step is in its plane. False when the sample leaves either cell or does not get inside O.
 constexpr int kSlideSteps = 4;
+// Support points tested per coarse cell: those within this fraction of the cell size of the
+// farthest toward the other body (cell_support.h).
+constexpr double kSupportBandRel = 0.05;
 constexpr int kDescentSteps = 4;  // after entering: on down to the deepest point
 
 struct SlideFrame {
@@ -161,13 +181,14 @@ struct SlideFrame {
   double maxStep;   // one sample spacing
 };
 
-bool slideIntoOther(const SlideFrame& fr, Vec3& pS, SurfacePoint& surface, Vec3& pO, ContactFieldSample& f) {
+bool slideIntoOther(const SlideFrame& fr, Vec3& pS, SurfacePoint& surface, Vec3& pO, ContactFieldSample& f, bool inside) {
   // Entering is not the answer: a small footprint (a leg, a bunny's base) pierces O's surface, and
   // the point where S enters has depth ~0 while the body is deeper -- the solver then let spot
   // rest 1.4 % of its diagonal inside the ground. So once inside, the slide goes on downhill
   // along S's surface while O's distance keeps falling (each step as long as the depth so far,
-  // at most one spacing), and keeps the deepest point it reached (curved surfaces only).
-  bool entered = false;
+  // at most one spacing), and keeps the deepest point it reached (curved surfaces only). A point
+  // that starts `inside` O only descends.
+  bool entered = inside;
   Vec3 bestS = pS, bestO = pO;
   SurfacePoint bestSurface = surface;
   ContactFieldSample best = f;
@@ -277,6 +298,7 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
     }
   }
   const double conflictCos = std::cos(settings.normalConflictDeg * kPi / 180.0);
+  const std::size_t firstOut = out.size();
   const bool flatS = double(hs->fitError) <= kFlatFitRel * h;
   // The plane of an inner cell that holds edges, corners or several faces is no surface (a
   // slab's 5 m cell fits a plane through the slab's middle, standing on end): its lattice points
@@ -292,80 +314,120 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
   const SlideFrame slide{treeS, cellS, treeO, cellO, xfOFromS, xfOFromS.rotation.conjugate().toRotationMatrix(),
                          settings.maxDepth, settings.marginAbs, project,
                          spread ? std::max(spreadStepU, spreadStepV) : spacing};
+  // One starting point on S's surface: its off-surface layers, the test against O's field, the
+  // slide into O, the normal rules, the contact.
+  auto samplePoint = [&](const Vec3& onSurface, SurfacePoint surface, int pointLayers, bool inCellOnly, bool descend) {
+    Vec3 normalWorldS = xfWorldFromS.rotation * surface.normal;
+    for (int layer = 0; layer < pointLayers; ++layer) {
+      Vec3 pS = onSurface - (layer * settings.offSurfaceDepthRel * hMin) * surface.normal;
+      if (inCellOnly && !insideCell(treeS, cellS, pS)) continue;
+      // The layer below the surface must lie in S: half a coarse cell below one face of a thin
+      // body is past its far face (a 0.45 m box's root cell is 1.1 m), where O's field would
+      // report a phantom penetration -- a box resting on a slab got 5-10 cm deep contacts
+      // from points outside it, was lifted and tipped 14 degrees.
+      if (layer > 0 && !(treeS.sample(pS, settings.maxDepth).distance < 0.0)) continue;
+      Vec3 pWorld = xfWorldFromS.apply(pS);
+      Vec3 pO = xfWorldFromO.applyInverse(pWorld);
+      if (!insideCell(treeO, cellO, pO)) continue;
+      ContactFieldSample f = treeO.sample(pO, settings.maxDepth);
+      if (f.distance > settings.marginAbs) {
+        Vec3 slidS = pS, slidO = pO;
+        SurfacePoint slidSurface = surface;
+        if (!spread || layer > 0 || !slideIntoOther(slide, slidS, slidSurface, slidO, f, false)) continue;
+        pS = slidS;
+        pO = slidO;
+        surface = slidSurface;
+        pWorld = xfWorldFromS.apply(pS);
+        normalWorldS = xfWorldFromS.rotation * surface.normal;
+      } else if (descend && slideIntoOther(slide, pS, surface, pO, f, true)) {
+        pWorld = xfWorldFromS.apply(pS);
+        normalWorldS = xfWorldFromS.rotation * surface.normal;
+      }
+      const double gradientLength = f.gradient.norm();
+      if (!(gradientLength > 1e-12)) continue;  // flat interpolant: no direction to push
+      Vec3 normal = xfWorldFromO.rotation * (f.gradient / gradientLength);
+      const bool conflict = normal.dot(-normalWorldS) < conflictCos;
+      // Where our cell holds an edge, or the other field disagrees with our plane, two edges
+      // may be crossing: if both fields show an edge around the sample, neither gradient
+      // alone is the contact normal (each leans toward one of its faces), the common
+      // perpendicular of the edges is. The gradients must be probed on both sides of each
+      // edge's kink (the leaves there may lie on one side), so the probe radius is twice the
+      // larger of the two cells.
+      const double rho = 2.0 * std::max(surface.size, treeO.cellSize(f.depth));
+      // A sample that only grazes the other body (depth within the field's error) where the
+      // other field turns away from our surface: a flush side face seen from the face or the
+      // edge beside it (a box on an equal box: the upper box's bottom edge lies in the lower
+      // box's side plane, and the lower field there points out of that side). It would push
+      // sideways along a face that nothing presses on; the cfm model drops such contacts
+      // too. Two crossing edges also touch at shallow depths with conflicting fields, so the
+      // drop comes after the edge-edge rule has had its say (on our edge).
+      const bool shallow = -f.distance <= std::max(f.errorBound, treeO.errorAbs) + surface.residual;
+      const bool grazing = conflict && shallow;
+      if (grazing && surface.flat) continue;
+      // Within that error band the other field's direction is its rounding, not a surface: next
+      // to its edges the interpolated gradient leans toward the side face, if less than the
+      // conflict angle (a box sliding down a slope met a zero-depth contact under its front edge
+      // tilted 9 degrees back, tipped and lost 12 % of its travel). Our flat face is the one
+      // surface known there, so a shallow sample on it pushes along its normal.
+      if (shallow && surface.flat) normal = -normalWorldS;
+      if (settings.edgeEdgeNormals && (conflict || !surface.flat) &&
+          edgeEdgeNormal(treeS, pS, xfWorldFromS, rho, treeO, pO, xfWorldFromO, rho, settings.maxDepth, normal)) {
+        // Two edges that cross inside a plane both bodies have a face in (the upper box's
+        // top edge and the lower box's vertical edge, both in their flush side plane) have
+        // that plane's normal as their common perpendicular: a grazing sample there is a
+        // flush face too.
+        if (grazing && flushAlong(treeS, xfWorldFromS, treeO, xfWorldFromO, pWorld, normal, rho, settings.maxDepth)) continue;
+        if (edgeEdgeCount) ++*edgeEdgeCount;
+      } else if (grazing && settings.edgeEdgeNormals) {
+        continue;  // (with the edge-edge rule off, crossing edges keep their gradient contacts)
+      } else if (conflict && surface.flat) {
+        // The other body shows an edge or corner here while our cell is a flat face: an edge
+        // or vertex on a face pushes along the face normal, not along the rounded field.
+        const ContactHalfSpace* ho = treeO.halfSpace(f.node);
+        if (ho && double(ho->fitError) > kFlatFitRel * treeO.cellSize(f.depth)) normal = -normalWorldS;
+      }
+      out.push_back({pWorld, normal, -f.distance, f.errorBound + surface.residual, 0});
+      break;  // the off-surface sample below a contact would only repeat it, deeper
+    }
+  };
   for (int i = iFirst; i <= i0 + reach; ++i) {
     for (int j = jFirst; j <= j0 + reach; ++j) {
       Vec3 onSurface = spread ? Vec3(spreadOrigin + (i * spreadStepU) * u + (j * spreadStepV) * v)
                               : Vec3(onPlane + (i * spacing) * u + (j * spacing) * v);
       SurfacePoint surface{n, flatS, h, 0.0};
       if (project && !projectOntoSurface(treeS, settings.maxDepth, onSurface, surface)) continue;
-      Vec3 normalWorldS = xfWorldFromS.rotation * surface.normal;
-      for (int layer = 0; layer < layers; ++layer) {
-        Vec3 pS = onSurface - (layer * settings.offSurfaceDepthRel * hMin) * surface.normal;
-        if (!insideCell(treeS, cellS, pS)) continue;
-        // The layer below the surface must lie in S: half a coarse cell below one face of a thin
-        // body is past its far face (a 0.45 m box's root cell is 1.1 m), where O's field would
-        // report a phantom penetration -- a box resting on a slab got 5-10 cm deep contacts
-        // from points outside it, was lifted and tipped 14 degrees.
-        if (layer > 0 && !(treeS.sample(pS, settings.maxDepth).distance < 0.0)) continue;
-        Vec3 pWorld = xfWorldFromS.apply(pS);
-        Vec3 pO = xfWorldFromO.applyInverse(pWorld);
+      samplePoint(onSurface, surface, layers, true, false);
+    }
+  }
+  // An interrupted query's coarse cell also offers its support points (cell_support.h): the
+  // points of its surface that reach farthest in 386 directions, among them the deepest point
+  // of a body entering O where the lattice's spacing is larger than the contact region (a
+  // fandisk's corner, a bunny's lowest bump). Where O is flat near the cell, S's deepest point
+  // is its support point along minus O's normal, so the points that reach within
+  // kSupportBandRel of the cell size as far as any along it are tested: O's gradient where the
+  // lattice found its deepest contact, else at the cell's centre (not that contact's normal,
+  // which the edge rules may have turned: spot's lowest foot was missed along a normal 21
+  // degrees off the floor's). They lie on the
+  // cell's closed boundary, so the own-cell test is skipped; the test against O's cell keeps one
+  // frontier pair from repeating another's.
+  if (spread && settings.supportPoints) {
+    const std::span<const Vec3> supports = treeS.cellSupports(cellS.node);
+    if (!supports.empty()) {
+      Vec3 probe = xfOFromS.apply(treeS.cellCenter(cellS));
+      for (std::size_t i = firstOut, deepest = firstOut; i < out.size(); ++i)
+        if (out[i].depth >= out[deepest].depth) deepest = i, probe = xfWorldFromO.applyInverse(out[i].point);
+      const Vec3 towardO = -(slide.sFromO * treeO.sample(probe, settings.maxDepth).gradient);
+      double farthest = -std::numeric_limits<double>::infinity();
+      for (const Vec3& p : supports) farthest = std::max(farthest, towardO.dot(p));
+      const double band = kSupportBandRel * h * towardO.norm();
+      for (const Vec3& p : supports) {
+        if (towardO.dot(p) < farthest - band) continue;
+        const Vec3 pO = xfOFromS.apply(p);
         if (!insideCell(treeO, cellO, pO)) continue;
-        ContactFieldSample f = treeO.sample(pO, settings.maxDepth);
-        if (f.distance > settings.marginAbs) {
-          Vec3 slidS = pS, slidO = pO;
-          SurfacePoint slidSurface = surface;
-          if (!spread || layer > 0 || !slideIntoOther(slide, slidS, slidSurface, slidO, f)) continue;
-          pS = slidS;
-          pO = slidO;
-          surface = slidSurface;
-          pWorld = xfWorldFromS.apply(pS);
-          normalWorldS = xfWorldFromS.rotation * surface.normal;
-        }
-        const double gradientLength = f.gradient.norm();
-        if (!(gradientLength > 1e-12)) continue;  // flat interpolant: no direction to push
-        Vec3 normal = xfWorldFromO.rotation * (f.gradient / gradientLength);
-        const bool conflict = normal.dot(-normalWorldS) < conflictCos;
-        // Where our cell holds an edge, or the other field disagrees with our plane, two edges
-        // may be crossing: if both fields show an edge around the sample, neither gradient
-        // alone is the contact normal (each leans toward one of its faces), the common
-        // perpendicular of the edges is. The gradients must be probed on both sides of each
-        // edge's kink (the leaves there may lie on one side), so the probe radius is twice the
-        // larger of the two cells.
-        const double rho = 2.0 * std::max(surface.size, treeO.cellSize(f.depth));
-        // A sample that only grazes the other body (depth within the field's error) where the
-        // other field turns away from our surface: a flush side face seen from the face or the
-        // edge beside it (a box on an equal box: the upper box's bottom edge lies in the lower
-        // box's side plane, and the lower field there points out of that side). It would push
-        // sideways along a face that nothing presses on; the cfm model drops such contacts
-        // too. Two crossing edges also touch at shallow depths with conflicting fields, so the
-        // drop comes after the edge-edge rule has had its say (on our edge).
-        const bool shallow = -f.distance <= std::max(f.errorBound, treeO.errorAbs) + surface.residual;
-        const bool grazing = conflict && shallow;
-        if (grazing && surface.flat) continue;
-        // Within that error band the other field's direction is its rounding, not a surface: next
-        // to its edges the interpolated gradient leans toward the side face, if less than the
-        // conflict angle (a box sliding down a slope met a zero-depth contact under its front edge
-        // tilted 9 degrees back, tipped and lost 12 % of its travel). Our flat face is the one
-        // surface known there, so a shallow sample on it pushes along its normal.
-        if (shallow && surface.flat) normal = -normalWorldS;
-        if (settings.edgeEdgeNormals && (conflict || !surface.flat) &&
-            edgeEdgeNormal(treeS, pS, xfWorldFromS, rho, treeO, pO, xfWorldFromO, rho, settings.maxDepth, normal)) {
-          // Two edges that cross inside a plane both bodies have a face in (the upper box's
-          // top edge and the lower box's vertical edge, both in their flush side plane) have
-          // that plane's normal as their common perpendicular: a grazing sample there is a
-          // flush face too.
-          if (grazing && flushAlong(treeS, xfWorldFromS, treeO, xfWorldFromO, pWorld, normal, rho, settings.maxDepth)) continue;
-          if (edgeEdgeCount) ++*edgeEdgeCount;
-        } else if (grazing && settings.edgeEdgeNormals) {
-          continue;  // (with the edge-edge rule off, crossing edges keep their gradient contacts)
-        } else if (conflict && surface.flat) {
-          // The other body shows an edge or corner here while our cell is a flat face: an edge
-          // or vertex on a face pushes along the face normal, not along the rounded field.
-          const ContactHalfSpace* ho = treeO.halfSpace(f.node);
-          if (ho && double(ho->fitError) > kFlatFitRel * treeO.cellSize(f.depth)) normal = -normalWorldS;
-        }
-        out.push_back({pWorld, normal, -f.distance, f.errorBound + surface.residual, 0});
-        break;  // the off-surface sample below a contact would only repeat it, deeper
+        if (treeO.sample(pO, settings.maxDepth).distance > settings.marginAbs) continue;
+        SurfacePoint surface;
+        if (!surfacePointAt(treeS, settings.maxDepth, p, surface)) continue;
+        samplePoint(p, surface, 1, false, true);
       }
     }
   }

@@ -36,7 +36,8 @@ std::size_t ContactTree::memoryBytes() const {
          levelOffsets.size() * sizeof(std::uint32_t) +
          lattice.size() * sizeof(float) + halfSpaces.size() * sizeof(ContactHalfSpace) + sizeof(rootCorners) +
          gridNode.size() * sizeof(std::uint32_t) + gridCorners.size() * sizeof(float) +
-         flatSurface.size() * sizeof(std::uint64_t);
+         flatSurface.size() * sizeof(std::uint64_t) + supportOffsets.size() * sizeof(std::uint32_t) +
+         supportPoints.size() * sizeof(Vec3);
 }
 
 std::uint16_t ContactTree::encodeErrorRatio(double ratio) {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "clod/bake.h"
+#include "clod/cell_support.h"
 #include "clod/error.h"
 #include "patch_hull.h"
 
@@ -272,6 +273,7 @@ void CollisionBody::setClosestFeatureMap(ClosestFeatureMap map) {
 void CollisionBody::setContactTree(ContactTree tree) {
   if (tree.nodeCount() == 0) fail("contact tree has no nodes");
   contactTree_ = std::move(tree);
+  deriveCellSupports(*contactTree_, mesh_);
 }
 
 const ClosestFeatureMap& CollisionBody::closestFeatureMap() const noexcept {

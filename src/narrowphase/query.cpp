@@ -1682,6 +1682,7 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
     fillFrontier(s.cellFront, sa, sb, result);
     ContactSamplingSettings sampling = settings.contactSampling;
     sampling.maxDepth = kContactTreeLeafDepth;
+    sampling.supportPoints = !finished;
     s.sampled.clear();
     AnswerClock answer(settings.budget, 1);
     for (const CellPair& p : s.cellFront) {
