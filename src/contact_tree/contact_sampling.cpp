@@ -407,9 +407,11 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
   // kSupportBandRel of the cell size as far as any along it are tested: O's gradient where the
   // lattice found its deepest contact, else at the cell's centre (not that contact's normal,
   // which the edge rules may have turned: spot's lowest foot was missed along a normal 21
-  // degrees off the floor's). They lie on the
-  // cell's closed boundary, so the own-cell test is skipped; the test against O's cell keeps one
-  // frontier pair from repeating another's.
+  // degrees off the floor's). Each tested point inside O descends along S's surface to its
+  // deepest (slideIntoOther). They lie on the cell's closed boundary, so the own-cell test is
+  // skipped; the test against O's cell keeps one frontier pair from repeating another's. Only
+  // for interrupted answers (ContactSamplingSettings::supportPoints): a finished traversal's
+  // final cells are small or flat, and the reference answer stays the lattice's.
   if (spread && settings.supportPoints) {
     const std::span<const Vec3> supports = treeS.cellSupports(cellS.node);
     if (!supports.empty()) {
