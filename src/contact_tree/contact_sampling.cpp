@@ -128,18 +128,20 @@ bool describeSurface(const ContactTree& tree, const ContactFieldSample& f, Surfa
 
 // Moves p (S frame) onto the zero level of S's field by Newton steps along the gradient (one
 // step lands on a face, a second settles an edge or a corner). False when it does not get within
-// twice eps_s of the surface in four steps (a point near the medial axis, a vanishing
-// gradient): such a lattice point has no surface point to stand for. The tolerance is eps_s, not
-// the cell's error bound: a coarse cell far from the surface bounds its error by up to half its
-// diagonal, and a point accepted within twice that lay 19 cm off a 1.4 m fandisk -- a contact
-// where the body is not, on which it rocked while its real lowest point sank 12 % of its
-// diagonal into the floor. Newton steps on the interpolant reach its zero level whatever the
-// cells' error.
+// twice the field's error of the surface in four steps (a point near the medial axis, a
+// vanishing gradient): such a lattice point has no surface point to stand for. The error counted
+// is eps_s, or the cell's bound up to the finest cell's size (cells at the depth limit near
+// edges and feet bound theirs above eps_s; with eps_s alone their points failed to land, and spot
+// lost the samples under its feet and toppled at 256 tests). Not more: a coarse cell far from the
+// surface bounds its error by up to half its diagonal, and a point accepted within twice that lay
+// 19 cm off a 1.4 m fandisk -- a contact where the body is not, on which it rocked while its real
+// lowest point sank 12 % of its diagonal into the floor.
 bool projectOntoSurface(const ContactTree& tree, std::uint32_t maxDepth, Vec3& p, SurfacePoint& at) {
+  const double finest = tree.cellSize(tree.maxDepth);
   for (int step = 0; step < 4; ++step) {
     const ContactFieldSample f = tree.sample(p, maxDepth);
     if (!describeSurface(tree, f, at)) return false;
-    if (at.residual <= 2.0 * tree.errorAbs) return true;
+    if (at.residual <= 2.0 * std::max(tree.errorAbs, std::min(f.errorBound, finest))) return true;
     p -= f.distance * at.normal / f.gradient.norm();
   }
   return false;

@@ -1,0 +1,200 @@
+#!/usr/bin/env python3
+"""Randomised variants of issue 17's scene categories, run through `clod simulate` and judged by
+the issue's numbers (docs/benchmarks/degradation.md, "Random drops").
+
+usage: scripts/probe-random-scenes.py SEED KINDS OUTDIR
+  KINDS: comma-separated of stack, pyramid, slide, slope-rest, slope-slide, drop
+  environment: MODELS (cfm,contact-tree,exact), BUDGETS tests per frame (16,64,256,1024,0),
+  BUS microseconds per frame (50,200,1000), RATES (240,60), J parallel runs (2),
+  CLOD (build/bin/clod), CLOD_MESH_DIR (../shared/data/meshes).
+Prints one FAIL line per run that breaks a criterion of issue 17's point 1 (drops: the lowest
+vertex more than 1 % of the diagonal below the floor top at any frame, or still moving after
+5 s), NONMONO lines where the run's error grew with the budget, and a count. Each run's scene,
+trajectory and summary stay in OUTDIR.
+"""
+import json, math, os, random, subprocess, sys, csv, concurrent.futures as cf
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+CLOD = os.environ.get('CLOD', os.path.join(ROOT, 'build', 'bin', 'clod'))
+MESHES = os.environ.get('CLOD_MESH_DIR', os.path.join(ROOT, '..', 'shared', 'data', 'meshes'))
+G = 9.81
+def qz(deg):
+    a = math.radians(deg) / 2; return [math.cos(a), 0, 0, math.sin(a)]
+def qy(deg):
+    a = math.radians(deg) / 2; return [math.cos(a), 0, math.sin(a), 0]
+def qmul(a, b):
+    w1,x1,y1,z1=a; w2,x2,y2,z2=b
+    return [w1*w2-x1*x2-y1*y2-z1*z2, w1*x2+x1*w2+y1*z2-z1*y2, w1*y2-x1*z2+y1*w2+z1*x2, w1*z2+x1*y2-y1*x2+z1*w2]
+def rot(q, v):
+    w,x,y,z=q
+    m=[[1-2*(y*y+z*z),2*(x*y-w*z),2*(x*z+w*y)],[2*(x*y+w*z),1-2*(x*x+z*z),2*(y*z-w*x)],[2*(x*z-w*y),2*(y*z+w*x),1-2*(x*x+y*y)]]
+    return [sum(m[i][j]*v[j] for j in range(3)) for i in range(3)]
+def tilt(q0, q):
+    # angle between body z axes
+    a = rot(q0, [0,0,1]); b = rot(q, [0,0,1])
+    d = max(-1,min(1,sum(x*y for x,y in zip(a,b)))); return math.degrees(math.acos(d))
+def ground(hx, hy, mu, pos=(0,0,-0.25), q=None, hz=0.25):
+    b = {"name":"ground","box":[hx,hy,hz],"position":list(pos),"static":True,"friction":mu}
+    if q: b["orientation"]=q
+    return b
+def boxb(name, h, pos, mu, q=None, v=None, extra=None):
+    b = {"name":name,"box":list(h),"position":list(pos),"friction":mu}
+    if q: b["orientation"]=q
+    if v: b["velocity"]=list(v)
+    if extra: b.update(extra)
+    return b
+
+def gen(kind, rng):
+    """Returns (scene dict, judge info)."""
+    if kind == 'stack':
+        n = rng.randint(3, 6); h = rng.uniform(0.1, 0.6); mu = rng.uniform(0.4, 0.9)
+        twist = rng.choice([0, 0, rng.uniform(3, 20)])
+        bodies = [ground(4*h+1, 4*h+1, mu, (0,0,-0.25))]
+        for k in range(n):
+            bodies.append(boxb(f"box{k}", [h,h,h], [0,0,h*(2*k+1)], mu, qz(twist*k) if twist else None))
+        return {"duration":10.0,"bodies":bodies}, dict(kind='stack', move=0.02, tiltlim=1.0, speed=0.05)
+    if kind == 'pyramid':
+        rows = rng.randint(3, 4); h = rng.uniform(0.2, 0.6); gap = rng.uniform(0.0, 0.04)*h; mu = rng.uniform(0.5, 0.9)
+        bodies = [ground(rows*h*2+1, 2*h+1, mu)]
+        pitch = 2*h+gap
+        for r in range(rows):
+            c = rows - r
+            for i in range(c):
+                bodies.append(boxb(f"box{r}{i}", [h,h,h], [(i-0.5*(c-1))*pitch, 0, h*(2*r+1)], mu))
+        return {"duration":10.0,"bodies":bodies}, dict(kind='stack', move=0.05, tiltlim=2.0, speed=0.05)
+    if kind == 'slide':
+        h = [rng.uniform(0.2,0.6), rng.uniform(0.2,0.6), rng.uniform(0.15,0.5)]
+        mu = rng.uniform(0.2, 0.6); v = rng.uniform(1.0, 3.0); ang = rng.uniform(0, 360)
+        d = v*v/(2*mu*G)
+        dirv = [math.cos(math.radians(ang)), math.sin(math.radians(ang)), 0]
+        L = d + 3
+        bodies = [ground(L, L, mu), boxb("box", h, [-dirv[0]*d/2, -dirv[1]*d/2, h[2]], mu, qz(rng.uniform(0,90)), [v*dirv[0], v*dirv[1], 0])]
+        return {"duration": v/(mu*G)+1.5, "bodies":bodies}, dict(kind='slide', dist=d, tiltlim=2.0)
+    if kind in ('slope-rest', 'slope-slide'):
+        mu = rng.uniform(0.3, 0.8); fa = math.degrees(math.atan(mu))
+        th = rng.uniform(8, fa-5) if kind == 'slope-rest' else rng.uniform(fa+6, min(fa+25, 60))
+        h = [rng.uniform(0.2,0.5)]*2 + [rng.uniform(0.15,0.5)]
+        q = qy(th); n = rot(q,[0,0,1]); down = rot(q,[1,0,0])
+        T = 4.0 if kind=='slope-rest' else 2.0
+        a = G*(math.sin(math.radians(th)) - mu*math.cos(math.radians(th)))
+        HL = 2.0 if kind=='slope-rest' else max(5.0, a*T*T/2 + 2)
+        along = 0 if kind=='slope-rest' else -(HL-1.0)
+        pos = [ (0.25+h[2])*n[i] + along*down[i] for i in range(3)]
+        bodies = [ground(HL, 1.5, mu, (0,0,0), q), boxb("box", h, pos, mu, q)]
+        j = dict(kind=kind, T=T, a=a, down=down)
+        return {"duration":T, "bodies":bodies}, j
+    if kind == 'drop':
+        mesh = rng.choice(['bunny-1500','spot','fandisk'])
+        V = load_obj(os.path.join(MESHES, f'{mesh}.obj'))
+        lo=[min(v[i] for v in V) for i in range(3)]; hi=[max(v[i] for v in V) for i in range(3)]
+        diag0=math.sqrt(sum((hi[i]-lo[i])**2 for i in range(3)))
+        want=rng.uniform(0.3,1.5); sc=want/diag0
+        ax=[rng.gauss(0,1) for _ in range(3)]; n=math.sqrt(sum(a*a for a in ax)); ang=rng.uniform(0,math.pi)
+        q=[math.cos(ang/2)]+[math.sin(ang/2)*a/n for a in ax]
+        W=[rot(q,[c*sc for c in v]) for v in V]
+        zmin=min(w[2] for w in W); height=rng.uniform(0.05,1.0)
+        cx=sum(w[0] for w in W)/len(W); cy=sum(w[1] for w in W)/len(W)
+        body={"name":"mesh","mesh":os.path.abspath(os.path.join(MESHES, f"{mesh}.obj")),"scale":sc,"position":[-cx,-cy,height-zmin],"orientation":q,"friction":rng.uniform(0.3,0.8)}
+        return {"duration":5.0,"bodies":[ground(2,2,0.6),body]}, dict(kind='drop', verts=[[c*sc for c in v] for v in V], diag=want)
+    raise ValueError(kind)
+
+def load_obj(path):
+    V=[]
+    for line in open(path):
+        if line.startswith('v '): V.append([float(x) for x in line.split()[1:4]])
+    return V
+
+def judge(traj, info, dt):
+    rows = list(csv.DictReader(open(traj)))
+    names = sorted({r['body'] for r in rows if r['body']!='ground'})
+    last = {}; first = {}
+    for r in rows:
+        if r['body']=='ground': continue
+        b=r['body']
+        if b not in first: first[b]=r
+        last[b]=r
+    P=lambda r:[float(r['px']),float(r['py']),float(r['pz'])]
+    Q=lambda r:[float(r['qw']),float(r['qx']),float(r['qy']),float(r['qz'])]
+    V=lambda r:[float(r['vx']),float(r['vy']),float(r['vz'])]
+    dist=lambda a,b: math.sqrt(sum((x-y)**2 for x,y in zip(a,b)))
+    fails=[]; err=None
+    for b in names:
+        for v in P(last[b])+V(last[b]):
+            if not math.isfinite(v): return ['NaN'], float('nan')
+    if info['kind']=='stack':
+        # top = highest initial
+        top = max(names, key=lambda b: P(first[b])[2])
+        mv = dist(P(first[top]),P(last[top])); tl = tilt(Q(first[top]),Q(last[top])); sp = math.sqrt(sum(x*x for x in V(last[top])))
+        worst = max(dist(P(first[b]),P(last[b])) for b in names)
+        err = worst
+        if mv > info['move']: fails.append(f"top moved {mv*100:.1f}cm")
+        if tl > info['tiltlim']: fails.append(f"top tilt {tl:.1f}deg")
+        if sp > info['speed']: fails.append(f"top speed {sp*100:.1f}cm/s")
+    elif info['kind']=='slide':
+        b=names[0]; d = dist(P(first[b])[:2]+[0],P(last[b])[:2]+[0]); tl=max(tilt(Q(first[b]),Q(r)) for r in rows if r['body']==b)
+        err = abs(d-info['dist'])
+        if abs(d-info['dist'])>0.1*info['dist']: fails.append(f"slid {d:.3f} vs {info['dist']:.3f}")
+        if tl>info['tiltlim']: fails.append(f"tilt {tl:.1f}")
+    elif info['kind']=='slope-rest':
+        b=names[0]; d=dist(P(first[b]),P(last[b])); err=d
+        if d>0.02: fails.append(f"moved {d*100:.1f}cm")
+    elif info['kind']=='slope-slide':
+        b=names[0]; p0=P(first[b]); p1=P(last[b]); s=sum((p1[i]-p0[i])*info['down'][i] for i in range(3))
+        T=float(last[b]['time']); want=info['a']*T*T/2; err=abs(s-want)
+        if abs(s-want)>0.1*want: fails.append(f"slid {s:.3f} vs {want:.3f}")
+    elif info['kind']=='drop':
+        b=names[0]; worst=-1e9
+        for r in rows:
+            if r['body']!=b: continue
+            p=P(r); q=Q(r); R=[rot(q,[1,0,0]),rot(q,[0,1,0]),rot(q,[0,0,1])]
+            zs=[R[0][2]*v[0]+R[1][2]*v[1]+R[2][2]*v[2] for v in info['verts']]
+            worst=max(worst,-(min(zs)+p[2])/info['diag'])
+        err=worst
+        lastp=P(last[b])
+        if worst>0.01: fails.append(f"sank {worst*100:.2f}%")
+        if math.sqrt(sum(x*x for x in V(last[b])))>0.05: fails.append('not at rest %.2f m/s'%math.sqrt(sum(x*x for x in V(last[b]))))
+    return fails, err
+
+def run_one(args):
+    sid, scene, info, model, budget, bus, rate, outroot = args
+    sc = dict(scene); sc['dt']=1.0/rate; sc['contact_model']=model; sc['budget']=budget
+    if bus: sc['budget_us']=bus
+    d = os.path.join(outroot, f"{sid}_{model}_{budget}_{bus}_{rate}"); os.makedirs(d, exist_ok=True)
+    f = os.path.join(d,'scene.json'); json.dump(sc, open(f,'w'))
+    r = subprocess.run(['nice', CLOD,'simulate',f,'-o',os.path.join(d,'out')],capture_output=True,text=True,timeout=600)
+    if r.returncode!=0: return (sid,model,budget,bus,rate,['exit %d: %s'%(r.returncode,r.stderr.strip()[-200:])],float('nan'))
+    fails, err = judge(os.path.join(d,'out','trajectory.csv'), info, 1.0/rate)
+    return (sid,model,budget,bus,rate,fails,err)
+
+if __name__=='__main__':
+    seed=int(sys.argv[1]); kinds=sys.argv[2].split(','); outroot=sys.argv[3]
+    models=os.environ.get('MODELS','cfm,contact-tree,exact').split(',')
+    budgets=[int(x) for x in os.environ.get('BUDGETS','16,64,256,1024,0').split(',') if x]
+    buss=[float(x) for x in os.environ.get('BUS','50,200,1000').split(',') if x]
+    rates=[float(x) for x in os.environ.get('RATES','240,60').split(',')]
+    rng=random.Random(seed); jobs=[]
+    for kind in kinds:
+        scene, info = gen(kind, rng); sid=f"{kind}{seed}_{len(jobs)}"
+        os.makedirs(outroot, exist_ok=True)
+        with open(os.path.join(outroot, sid + '.json'), 'w') as f:
+            json.dump({'scene': scene, 'info': {k: v for k, v in info.items() if k != 'verts'}}, f)
+        for m in models:
+            for rate in rates:
+                for b in budgets: jobs.append((sid,scene,info,m,b,0,rate,outroot))
+                for u in buss: jobs.append((sid,scene,info,m,0,u,rate,outroot))
+    res=[]
+    with cf.ThreadPoolExecutor(int(os.environ.get('J','2'))) as ex:
+        for r in ex.map(run_one, jobs): res.append(r)
+    # monotone check: per sid, model, rate: test budgets ordered 16..1024,0
+    for r in res:
+        if r[5]: print('FAIL', r[0], r[1], 'b=%d us=%g %gHz'%(r[2],r[3],r[4]), '; '.join(r[5]))
+    from collections import defaultdict
+    seq=defaultdict(dict)
+    for r in res:
+        if r[3]==0: seq[(r[0],r[1],r[4])][r[2]]=r[6]
+    for k,v in seq.items():
+        order=[b for b in budgets if b] + ([0] if 0 in budgets else [])
+        for a,b in zip(order,order[1:]):
+            ea, eb = v.get(a), v.get(b)
+            if ea is None or eb is None: continue
+            if not (eb <= ea + max(0.1*ea, 0.002)): print('NONMONO', k, f'{a}->{b}', f'{ea:.4f}->{eb:.4f}')
+    print('runs', len(res), 'failing', sum(1 for r in res if r[5]))
