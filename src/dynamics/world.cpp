@@ -805,13 +805,13 @@ bool World::Impl::keepFinerManifold(PairState& p, const Body& a, const Body& b, 
   return true;
 }
 
-// How far the two bodies of a candidate pair can move toward each other over dt (the arrival
-// rule of World::step). A pair without contacts: both bodies' whole travel. A pair in contact:
-// only the motion along its contacts' normals -- the relative velocity's normal part plus each
-// body's turn times its half diagonal, the most a point of it can approach -- since sliding
-// along the contact plane arrives nowhere: a box sliding down a slope at 5 m/s took the rule's
-// full substeps for a motion that could not press it deeper, while a tumbling fandisk's far
-// corner, coming down at 4 m/s while its other end touched, needs them.
+// How far the two bodies of a candidate pair can move toward each other over dt (the part of
+// the arrival rule that may take kMaxApproachSubsteps, World::step). A pair without contacts:
+// both bodies' whole travel. A pair in contact: only the motion along its contacts' normals --
+// the relative velocity's normal part plus each body's turn times its half diagonal, the most a
+// point of it can approach -- since sliding along the contact plane arrives nowhere: a box
+// sliding at 5 m/s keeps the rule's 8 substeps for its whole travel, while a tumbling fandisk's
+// far corner, coming down at 4 m/s while its other end touched, gets up to 16.
 double World::Impl::arrivalTravel(const BodyPair& c, double dt) const {
   const double both = stepTravel[c[0]] + stepTravel[c[1]];
   const auto found = pairs.find(pairKey(c[0], c[1]));
