@@ -79,6 +79,10 @@ struct ContactSamplingSettings {
   /// than its spacing. The query sets it when its traversal stopped at the budget; a finished
   /// traversal's final cells are sampled as before.
   bool supportPoints = false;
+  /// Where O's cell is flat (ContactTree::isFlatSurface) and S's cell has support points, those
+  /// below O's plane are the pair's samples instead of the lattice (finished and interrupted
+  /// queries alike): a flat partner is met first where S reaches farthest toward it.
+  bool flatPartnerSupports = true;
   /// Depth limit for field queries and traversal (kContactTreeLeafDepth: full resolution).
   /// A time-budgeted caller passes a smaller value to stop higher in both trees.
   std::uint32_t maxDepth = kContactTreeLeafDepth;

@@ -110,8 +110,20 @@ struct SurfacePoint {
   Vec3 normal;
   bool flat;
   double size;
-  double residual;
+  double residual;  // |offset|
+  double offset;    // S's field at the point: how far outside S's zero level it lies (signed)
 };
+
+// O's distance at the point of S's surface nearest p: p lies `offset` outside S's zero level
+// along S's normal, so to first order it is f_O(p) - offset (grad f_O . n_S). A point that a
+// projection or a descent left within its tolerance below S's face would otherwise count that
+// gap as depth: a box's corner descended 2 mm below its face into a slab, and the contact read
+// 4 mm for the overlap's 2.
+double distanceAtSurface(const ContactFieldSample& f, const SurfacePoint& s, const Eigen::Matrix3d& sFromO) {
+  const double length = f.gradient.norm();
+  if (s.offset == 0.0 || !(length > 1e-12)) return f.distance;
+  return f.distance - s.offset * (sFromO * f.gradient).dot(s.normal) / length;
+}
 
 // The surface data of S at p from S's field there: normal (the gradient), flatness and size of
 // the cell p lies in. False where the gradient vanishes.
@@ -122,6 +134,7 @@ bool describeSurface(const ContactTree& tree, const ContactFieldSample& f, Surfa
   const ContactHalfSpace* hs = tree.halfSpace(f.node);
   at.size = tree.cellSize(f.depth);
   at.flat = hs && double(hs->fitError) <= kFlatFitRel * at.size;
+  at.offset = f.distance;
   at.residual = std::abs(f.distance);
   return true;
 }
@@ -152,6 +165,7 @@ bool projectOntoSurface(const ContactTree& tree, std::uint32_t maxDepth, Vec3& p
 bool surfacePointAt(const ContactTree& tree, std::uint32_t maxDepth, const Vec3& p, SurfacePoint& at) {
   if (!describeSurface(tree, tree.sample(p, maxDepth), at)) return false;
   at.residual = 0.0;
+  at.offset = 0.0;
   return true;
 }
 
@@ -169,6 +183,7 @@ constexpr int kSlideSteps = 4;
 // farthest toward the other body (cell_support.h).
 constexpr double kSupportBandRel = 0.05;
 constexpr int kDescentSteps = 4;  // after entering: on down to the deepest point
+constexpr double kDescentGainRel = 0.01;  // a descent step must gain this fraction of eps_O
 
 struct SlideFrame {
   const ContactTree& treeS;
@@ -203,15 +218,20 @@ bool slideIntoOther(const SlideFrame& fr, Vec3& pS, SurfacePoint& surface, Vec3&
     const Vec3 tangent = g - g.dot(surface.normal) * surface.normal;
     const double slope = tangent.norm();
     if (!(slope > 1e-6)) break;  // O's field does not fall along S's surface here (a local minimum)
-    const double length = entered ? std::abs(f.distance) / slope : f.distance / slope;
+    const double d = distanceAtSurface(f, surface, fr.sFromO);
+    const double length = (entered ? std::abs(d) : d) / slope;
     pS -= std::min(length, fr.maxStep) * (tangent / slope);
     if (fr.project && !projectOntoSurface(fr.treeS, fr.maxDepth, pS, surface)) break;
     if (!insideCell(fr.treeS, fr.cellS, pS)) break;
     pO = fr.xfOFromS.apply(pS);
     if (!insideCell(fr.treeO, fr.cellO, pO)) break;
     f = fr.treeO.sample(pO, fr.maxDepth);
-    if (entered && f.distance >= best.distance) break;  // past the bottom
-    if (f.distance <= fr.marginAbs) {
+    // Past the bottom, or on a plane O's field is level along (a box's corner on a floor, where
+    // rounding alone made each step "deeper" and walked the corner's contact 2 cm inward).
+    if (entered && distanceAtSurface(f, surface, fr.sFromO) >
+                       distanceAtSurface(best, bestSurface, fr.sFromO) - kDescentGainRel * fr.treeO.errorAbs)
+      break;
+    if (distanceAtSurface(f, surface, fr.sFromO) <= fr.marginAbs) {
       entered = true;
       bestS = pS, bestO = pO, bestSurface = surface, best = f;
     }
@@ -318,11 +338,14 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
                          spread ? std::max(spreadStepU, spreadStepV) : spacing};
   // One starting point on S's surface: its off-surface layers, the test against O's field, the
   // slide into O, the normal rules, the contact.
-  auto samplePoint = [&](const Vec3& onSurface, SurfacePoint surface, int pointLayers, bool inCellOnly, bool descend) {
+  // support: a support point inside O (on S's cell's closed boundary, so not tested against
+  // it) rather than a lattice point: it descends to its deepest. flatO: O's cell is one plane (the
+  // flat-partner path below), whose field is exact to its cell's own bound and shows no edge.
+  auto samplePoint = [&](const Vec3& onSurface, SurfacePoint surface, int pointLayers, bool support, bool flatO) {
     Vec3 normalWorldS = xfWorldFromS.rotation * surface.normal;
     for (int layer = 0; layer < pointLayers; ++layer) {
       Vec3 pS = onSurface - (layer * settings.offSurfaceDepthRel * hMin) * surface.normal;
-      if (inCellOnly && !insideCell(treeS, cellS, pS)) continue;
+      if (!support && !insideCell(treeS, cellS, pS)) continue;
       // The layer below the surface must lie in S: half a coarse cell below one face of a thin
       // body is past its far face (a 0.45 m box's root cell is 1.1 m), where O's field would
       // report a phantom penetration -- a box resting on a slab got 5-10 cm deep contacts
@@ -332,7 +355,7 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
       Vec3 pO = xfWorldFromO.applyInverse(pWorld);
       if (!insideCell(treeO, cellO, pO)) continue;
       ContactFieldSample f = treeO.sample(pO, settings.maxDepth);
-      if (f.distance > settings.marginAbs) {
+      if ((layer == 0 ? distanceAtSurface(f, surface, slide.sFromO) : f.distance) > settings.marginAbs) {
         Vec3 slidS = pS, slidO = pO;
         SurfacePoint slidSurface = surface;
         if (!spread || layer > 0 || !slideIntoOther(slide, slidS, slidSurface, slidO, f, false)) continue;
@@ -341,12 +364,14 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
         surface = slidSurface;
         pWorld = xfWorldFromS.apply(pS);
         normalWorldS = xfWorldFromS.rotation * surface.normal;
-      } else if (descend && slideIntoOther(slide, pS, surface, pO, f, true)) {
+      } else if (support && slideIntoOther(slide, pS, surface, pO, f, true)) {
         pWorld = xfWorldFromS.apply(pS);
         normalWorldS = xfWorldFromS.rotation * surface.normal;
       }
       const double gradientLength = f.gradient.norm();
       if (!(gradientLength > 1e-12)) continue;  // flat interpolant: no direction to push
+      // (The off-surface layer lies inside S on purpose: its depth is O's field there.)
+      const double distance = layer == 0 ? distanceAtSurface(f, surface, slide.sFromO) : f.distance;
       Vec3 normal = xfWorldFromO.rotation * (f.gradient / gradientLength);
       const bool conflict = normal.dot(-normalWorldS) < conflictCos;
       // Where our cell holds an edge, or the other field disagrees with our plane, two edges
@@ -363,7 +388,10 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
       // sideways along a face that nothing presses on; the cfm model drops such contacts
       // too. Two crossing edges also touch at shallow depths with conflicting fields, so the
       // drop comes after the edge-edge rule has had its say (on our edge).
-      const bool shallow = -f.distance <= std::max(f.errorBound, treeO.errorAbs) + surface.residual;
+      // (O's eps_s is no bound of a flat cell's field: a box's corner 2 mm into a 10 m slab,
+      // whose eps_s is 1 cm, would count as grazing.)
+      const double fieldError = flatO ? double(f.errorBound) : std::max(double(f.errorBound), treeO.errorAbs);
+      const bool shallow = -distance <= fieldError + surface.residual;
       const bool grazing = conflict && shallow;
       if (grazing && surface.flat) continue;
       // Within that error band the other field's direction is its rounding, not a surface: next
@@ -372,7 +400,7 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
       // tilted 9 degrees back, tipped and lost 12 % of its travel). Our flat face is the one
       // surface known there, so a shallow sample on it pushes along its normal.
       if (shallow && surface.flat) normal = -normalWorldS;
-      if (settings.edgeEdgeNormals && (conflict || !surface.flat) &&
+      if (settings.edgeEdgeNormals && !flatO && (conflict || !surface.flat) &&
           edgeEdgeNormal(treeS, pS, xfWorldFromS, rho, treeO, pO, xfWorldFromO, rho, settings.maxDepth, normal)) {
         // Two edges that cross inside a plane both bodies have a face in (the upper box's
         // top edge and the lower box's vertical edge, both in their flush side plane) have
@@ -388,17 +416,36 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
         const ContactHalfSpace* ho = treeO.halfSpace(f.node);
         if (ho && double(ho->fitError) > kFlatFitRel * treeO.cellSize(f.depth)) normal = -normalWorldS;
       }
-      out.push_back({pWorld, normal, -f.distance, f.errorBound + surface.residual, 0});
+      out.push_back({pWorld, normal, -distance, f.errorBound + surface.residual, 0});
       break;  // the off-surface sample below a contact would only repeat it, deeper
     }
   };
+  // O's cell is one plane (a flat cell): S's surface enters it where S reaches farthest toward
+  // that plane, so the support points of S's cell that lie below it are the deepest points of
+  // the pair -- a box face's cell gives the corners of its piece of the face, which span the
+  // contact polygon exactly, where a lattice gave a grid of interior points (more samples, not
+  // more answer: a box sliding on a slab met 249 such pairs per query, 2 ms). Each descends
+  // along S's surface to its deepest point (curved cells). Where S's cell has no support points
+  // (below kCellSupportMaxDepth), the lattice below answers.
+  const std::span<const Vec3> supports = treeS.cellSupports(cellS.node);
+  if (settings.flatPartnerSupports && !supports.empty() && treeO.isFlatSurface(cellO.node)) {
+    for (const Vec3& p : supports) {
+      const Vec3 pO = xfOFromS.apply(p);
+      if (!insideCell(treeO, cellO, pO)) continue;
+      if (treeO.sample(pO, settings.maxDepth).distance > settings.marginAbs) continue;
+      SurfacePoint surface;
+      if (!surfacePointAt(treeS, settings.maxDepth, p, surface)) continue;
+      samplePoint(p, surface, 1, true, true);
+    }
+    return;
+  }
   for (int i = iFirst; i <= i0 + reach; ++i) {
     for (int j = jFirst; j <= j0 + reach; ++j) {
       Vec3 onSurface = spread ? Vec3(spreadOrigin + (i * spreadStepU) * u + (j * spreadStepV) * v)
                               : Vec3(onPlane + (i * spacing) * u + (j * spacing) * v);
-      SurfacePoint surface{n, flatS, h, 0.0};
+      SurfacePoint surface{n, flatS, h, 0.0, 0.0};
       if (project && !projectOntoSurface(treeS, settings.maxDepth, onSurface, surface)) continue;
-      samplePoint(onSurface, surface, layers, true, false);
+      samplePoint(onSurface, surface, layers, false, false);
     }
   }
   // An interrupted query's coarse cell also offers its support points (cell_support.h): the
@@ -415,7 +462,6 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
   // for interrupted answers (ContactSamplingSettings::supportPoints): a finished traversal's
   // final cells are small or flat, and the reference answer stays the lattice's.
   if (spread && settings.supportPoints) {
-    const std::span<const Vec3> supports = treeS.cellSupports(cellS.node);
     if (!supports.empty()) {
       Vec3 probe = xfOFromS.apply(treeS.cellCenter(cellS));
       for (std::size_t i = firstOut, deepest = firstOut; i < out.size(); ++i)
@@ -431,7 +477,7 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
         if (treeO.sample(pO, settings.maxDepth).distance > settings.marginAbs) continue;
         SurfacePoint surface;
         if (!surfacePointAt(treeS, settings.maxDepth, p, surface)) continue;
-        samplePoint(p, surface, 1, false, true);
+        samplePoint(p, surface, 1, true, false);
       }
     }
   }

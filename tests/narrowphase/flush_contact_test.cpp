@@ -230,5 +230,42 @@ TEST(FlushContact, ContactTreeManifoldReachesTheCornersOfAFaceOnFaceOverlap) {
   }
 }
 
+// A box resting 2 mm deep on a slab ten times its size: the slab's flat cells let the box's
+// cells answer with their support points (contact_sampling.h, flatPartnerSupports), so at
+// every budget the manifold has a contact at each corner of the box's bottom face, at the
+// overlap's depth. Oracle: the box's corners and the penetration, from the pose. Tolerances:
+// the contact's own error bound on the depth (plus 1e-6 of the diagonal for rounding); in the
+// plane one leaf of the box's tree (8 mm) from 256 tests on, where the slab's flat cells answer
+// (the corners are mesh vertices, so they come out exactly), and four leaves at 16 tests, where
+// the slab's coarse cells still hold its edges and the lattice and the rim walk answer
+// (measured 2.0-2.5 cm).
+TEST(FlushContact, ContactTreeGivesTheCornersOfABoxOnALargeSlabAtTheOverlapDepth) {
+  const CollisionBody box = test::makeTestBody(makeBox(Vec3::Constant(0.5)), 2);
+  const CollisionBody slab = test::makeTestBody(makeBox(Vec3(5.0, 1.5, 0.25)), 2);
+  const double penetration = 0.002;
+  const Vec3 centre(0.37, 0.1, 0.25 + 0.5 - penetration);
+  const Pose boxPose{Quat::Identity(), centre};
+  const double leaf = box.contactTree().cellSize(box.contactTree().maxDepth);
+  for (std::uint64_t budget : {std::uint64_t(16), std::uint64_t(256), kUnlimitedTests}) {
+    const std::string what = "contact-tree at " + std::to_string(budget);
+    const QueryResult r = queryContacts(box, boxPose, slab, Pose{}, settingsFor(ContactModel::kContactTree, budget));
+    dump(what, r);
+    ASSERT_FALSE(r.contacts.empty()) << what;
+    double deepest = -1.0;
+    for (const Contact& c : r.contacts) {
+      EXPECT_LE(c.depth, penetration + c.errorBound + 1e-6 * std::sqrt(3.0)) << what << " at " << c.point.transpose();
+      EXPECT_GT(c.normal.z(), std::cos(5.0 * kDegree)) << what << ": normal " << c.normal.transpose();
+      deepest = std::max(deepest, c.depth + c.errorBound);
+    }
+    EXPECT_GE(deepest, penetration) << what;
+    for (double x : {-0.5, 0.5}) {
+      for (double y : {-0.5, 0.5}) {
+        const Vec3 corner = centre + Vec3(x, y, -0.5);
+        EXPECT_LT(nearestInPlane(r, corner), (budget == 16 ? 4.0 : 1.0) * leaf) << what << ": corner " << corner.transpose();
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace clod

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -32,6 +33,24 @@ TEST(ReduceManifold, KeepsTheDeepestThenTheCornersOfASquareGrid) {
   for (std::size_t i = 1; i < 5; ++i) {
     EXPECT_NEAR(std::abs(contacts[i].point.x() - 0.5), 0.5, 1e-12);
     EXPECT_NEAR(std::abs(contacts[i].point.y() - 0.5), 0.5, 1e-12);
+  }
+}
+
+TEST(ReduceManifold, KeepsTheFourCornersOfARectangleWhoseDeepestContactLiesNearOne) {
+  // A 0.7 x 1 overlap sampled every 5 cm, the deepest sample 3.6 cm from the corner (0, 0): the
+  // four kept contacts lie at the four corners. (Farthest-point sampling alone kept the middle
+  // of the long side x = 0.7, 0.3 from the corner (0.7, 0).)
+  std::vector<Contact> contacts;
+  for (int i = 0; i <= 14; ++i)
+    for (int j = 0; j <= 20; ++j) contacts.push_back(at(0.05 * i, 0.05 * j, 0.1));
+  contacts.push_back(at(0.03, 0.02, 0.2));
+  std::vector<double> scratch;
+  const std::size_t n = reduceManifold(contacts, {4, 0.0}, scratch);
+  ASSERT_EQ(n, 4u);
+  for (const Vec3& corner : {Vec3(0.0, 0.0, 0.0), Vec3(0.7, 0.0, 0.0), Vec3(0.0, 1.0, 0.0), Vec3(0.7, 1.0, 0.0)}) {
+    double nearest = 1e9;
+    for (std::size_t i = 0; i < n; ++i) nearest = std::min(nearest, (contacts[i].point - corner).norm());
+    EXPECT_LT(nearest, 0.04) << "corner " << corner.transpose();  // the deepest stands for (0, 0)
   }
 }
 
