@@ -115,10 +115,12 @@ struct SurfacePoint {
 };
 
 // O's distance at the point of S's surface nearest p: p lies `offset` outside S's zero level
-// along S's normal, so to first order it is f_O(p) - offset (grad f_O . n_S). A point that a
-// projection or a descent left within its tolerance below S's face would otherwise count that
-// gap as depth: a box's corner descended 2 mm below its face into a slab, and the contact read
-// 4 mm for the overlap's 2.
+// along S's normal, so to first order it is f_O(p) - offset (grad f_O . n_S). The descent below
+// compares its steps by it: a step that lands within the projection's tolerance below S's face
+// is not deeper into O than where it started, though O's field there says so (a box's corner
+// descended 2 mm below its face into a slab and its contact read 4 mm for the overlap's 2). Only
+// the comparison: as the reported depth it made interrupted answers shallower than the mesh at
+// sharp corners (a random fandisk drop sank 1.7 % at 16 tests).
 double distanceAtSurface(const ContactFieldSample& f, const SurfacePoint& s, const Eigen::Matrix3d& sFromO) {
   const double length = f.gradient.norm();
   if (s.offset == 0.0 || !(length > 1e-12)) return f.distance;
@@ -218,8 +220,7 @@ bool slideIntoOther(const SlideFrame& fr, Vec3& pS, SurfacePoint& surface, Vec3&
     const Vec3 tangent = g - g.dot(surface.normal) * surface.normal;
     const double slope = tangent.norm();
     if (!(slope > 1e-6)) break;  // O's field does not fall along S's surface here (a local minimum)
-    const double d = distanceAtSurface(f, surface, fr.sFromO);
-    const double length = (entered ? std::abs(d) : d) / slope;
+    const double length = entered ? std::abs(f.distance) / slope : f.distance / slope;
     pS -= std::min(length, fr.maxStep) * (tangent / slope);
     if (fr.project && !projectOntoSurface(fr.treeS, fr.maxDepth, pS, surface)) break;
     if (!insideCell(fr.treeS, fr.cellS, pS)) break;
@@ -231,7 +232,7 @@ bool slideIntoOther(const SlideFrame& fr, Vec3& pS, SurfacePoint& surface, Vec3&
     if (entered && distanceAtSurface(f, surface, fr.sFromO) >
                        distanceAtSurface(best, bestSurface, fr.sFromO) - kDescentGainRel * fr.treeO.errorAbs)
       break;
-    if (distanceAtSurface(f, surface, fr.sFromO) <= fr.marginAbs) {
+    if (f.distance <= fr.marginAbs) {
       entered = true;
       bestS = pS, bestO = pO, bestSurface = surface, best = f;
     }
@@ -355,7 +356,7 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
       Vec3 pO = xfWorldFromO.applyInverse(pWorld);
       if (!insideCell(treeO, cellO, pO)) continue;
       ContactFieldSample f = treeO.sample(pO, settings.maxDepth);
-      if ((layer == 0 ? distanceAtSurface(f, surface, slide.sFromO) : f.distance) > settings.marginAbs) {
+      if (f.distance > settings.marginAbs) {
         Vec3 slidS = pS, slidO = pO;
         SurfacePoint slidSurface = surface;
         if (!spread || layer > 0 || !slideIntoOther(slide, slidS, slidSurface, slidO, f, false)) continue;
@@ -370,8 +371,7 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
       }
       const double gradientLength = f.gradient.norm();
       if (!(gradientLength > 1e-12)) continue;  // flat interpolant: no direction to push
-      // (The off-surface layer lies inside S on purpose: its depth is O's field there.)
-      const double distance = layer == 0 ? distanceAtSurface(f, surface, slide.sFromO) : f.distance;
+      const double distance = f.distance;
       Vec3 normal = xfWorldFromO.rotation * (f.gradient / gradientLength);
       const bool conflict = normal.dot(-normalWorldS) < conflictCos;
       // Where our cell holds an edge, or the other field disagrees with our plane, two edges
