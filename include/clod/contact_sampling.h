@@ -80,8 +80,10 @@ struct ContactSamplingSettings {
   /// traversal's final cells are sampled as before.
   bool supportPoints = false;
   /// Where O's cell is flat (ContactTree::isFlatSurface) and S's cell has support points, those
-  /// below O's plane are the pair's samples instead of the lattice (finished and interrupted
-  /// queries alike): a flat partner is met first where S reaches farthest toward it.
+  /// inside O are the pair's samples: a flat partner is met first where S reaches farthest
+  /// toward it. A finished query's pair takes them instead of the lattice; an interrupted
+  /// query's coarse pair (supportPoints) takes the lattice too, since 386 directions can miss
+  /// the lowest part of a nearly flat face.
   bool flatPartnerSupports = true;
   /// Depth limit for field queries and traversal (kContactTreeLeafDepth: full resolution).
   /// A time-budgeted caller passes a smaller value to stop higher in both trees.
