@@ -118,9 +118,10 @@ struct SurfacePoint {
 // along S's normal, so to first order it is f_O(p) - offset (grad f_O . n_S). The descent below
 // compares its steps by it: a step that lands within the projection's tolerance below S's face
 // is not deeper into O than where it started, though O's field there says so (a box's corner
-// descended 2 mm below its face into a slab and its contact read 4 mm for the overlap's 2). Only
-// the comparison: as the reported depth it made interrupted answers shallower than the mesh at
-// sharp corners (a random fandisk drop sank 1.7 % at 16 tests).
+// descended 2 mm below its face into a slab and its contact read 4 mm for the overlap's 2). A
+// sample reports it as its depth only on a flat leaf: near an edge or a corner S's zero level is
+// rounded inside the mesh, and the correction made interrupted answers shallower than the mesh
+// there (a random fandisk drop sank 1.7 % at 16 tests).
 double distanceAtSurface(const ContactFieldSample& f, const SurfacePoint& s, const Eigen::Matrix3d& sFromO) {
   const double length = f.gradient.norm();
   if (s.offset == 0.0 || !(length > 1e-12)) return f.distance;
@@ -371,7 +372,8 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
       }
       const double gradientLength = f.gradient.norm();
       if (!(gradientLength > 1e-12)) continue;  // flat interpolant: no direction to push
-      const double distance = f.distance;
+      // (The off-surface layer lies inside S on purpose: its depth is O's field there.)
+      const double distance = layer == 0 && surface.flat ? distanceAtSurface(f, surface, slide.sFromO) : f.distance;
       Vec3 normal = xfWorldFromO.rotation * (f.gradient / gradientLength);
       const bool conflict = normal.dot(-normalWorldS) < conflictCos;
       // Where our cell holds an edge, or the other field disagrees with our plane, two edges

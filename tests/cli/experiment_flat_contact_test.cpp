@@ -142,18 +142,23 @@ TEST(ExperimentFlatContactCli, ReferenceBoxRisesOverTheBumpButNotOnFlatGround) {
 // lateral friction held it straight: cfm was within 0.15 deg of it); cfm's contacts on the bump's
 // flank push along the box's face, not the slope, and its box stays straight: 5.6 deg off (docs/dynamics.md, "Known
 // limits").
-TEST(ExperimentFlatContactCli, CfmFollowsTheReferenceUpTheBump) {
+// The contact tree is held to the same bound (quick run: 17 mm; 28 mm before its flat partners
+// were answered by support points and a flat leaf's samples reported at its surface,
+// docs/contact-tree.md).
+TEST(ExperimentFlatContactCli, CfmAndTheContactTreeFollowTheReferenceUpTheBump) {
   if (clod::test::sanitizerRun()) GTEST_SKIP() << "contact-tree simulations: the Release run covers this test";
   const clod::test::CliRun run = runCli("experiment flat-contact --quick --trials 3 --json");
   ASSERT_EQ(run.exitCode, 0) << run.err;
   const auto doc = nlohmann::json::parse(run.out);
-  bool found = false;
-  for (const auto& row : doc["bump"]) {
-    if (row["model"] != "cfm") continue;
-    found = true;
-    EXPECT_LT(row["rms_position_error_mm"].get<double>(), 50.0);
+  for (const char* model : {"cfm", "contact-tree"}) {
+    bool found = false;
+    for (const auto& row : doc["bump"]) {
+      if (row["model"] != model) continue;
+      found = true;
+      EXPECT_LT(row["rms_position_error_mm"].get<double>(), 50.0) << model;
+    }
+    EXPECT_TRUE(found) << model;
   }
-  EXPECT_TRUE(found);
 }
 
 TEST(ExperimentFlatContactCli, BadTrialsExitWithTwo) {

@@ -133,10 +133,9 @@ INSTANTIATE_TEST_SUITE_P(MeshDrops, MeshDrop, testing::ValuesIn(dropCells()), ce
 
 // One of the random drops of scripts/probe-random-scenes.py (seed 24): a 0.76 m fandisk dropped
 // tumbling from 2.3 m lands on a corner. With the contact tree at 16 tests per frame it sank
-// 1.1-1.7 % of its diagonal while a sample's depth was measured at S's surface rather than at
-// the sample (docs/contact-tree.md, "Descent compares depths at S's surface"). Oracle: the
-// ground's top face and the mesh's own vertices; the issue's limit is 1 % of the diagonal at any
-// frame.
+// 1.1-1.7 % of its diagonal while every sample's depth was corrected to S's surface, near its
+// corners too (docs/contact-tree.md, "Depth at S's surface"). Oracle: the ground's top face and
+// the mesh's own vertices; the issue's limit is 1 % of the diagonal at any frame.
 TEST(RandomDrop, TumblingFandiskLandsOnACornerWithoutSinkingWithTheContactTree) {
   const std::string json = R"({"duration": 5.0, "contact_model": "contact-tree", "budget": 16, "bodies": [
       {"name": "ground", "box": [2, 2, 0.25], "position": [0, 0, -0.25], "static": true, "friction": 0.6},
