@@ -207,6 +207,48 @@ void BM_NarrowPhase_Query(benchmark::State& state, int mesh, int pose, ContactMo
   state.counters["finished"] = result.finished ? 1.0 : 0.0;
 }
 
+// A 1 m box resting 2 mm deep on a 10 x 3 x 0.5 m slab (the world's sliding and resting boxes,
+// issue 17): face on a larger face, where the contact tree's flat cells answer with the other
+// cell's support points (docs/contact-tree.md). Bodies as the world bakes them (octree spheres,
+// contact tree to depth 6).
+const CollisionBody& restingBody(bool slab) {
+  static std::unique_ptr<CollisionBody> cache[2];
+  std::unique_ptr<CollisionBody>& b = cache[slab ? 1 : 0];
+  if (b) return *b;
+  const TriangleMesh mesh = slab ? makeBox(Vec3(5.0, 1.5, 0.25)) : makeBox(Vec3::Constant(0.5));
+  BakeSettings settings;
+  settings.measureFit = false;
+  settings.sphereTree.method = SphereTreeMethod::kOctree;
+  settings.sphereTree.depth = 3;
+  settings.buildContactTree = false;
+  b = std::make_unique<CollisionBody>(CollisionBody::fromBake(bakeMesh(mesh, settings).contents));
+  ContactTreeSettings ct;
+  ct.maxDepth = 6;
+  b->setContactTree(buildContactTree(MeshDistance(mesh), ct));
+  return *b;
+}
+
+// supports = false: the contact tree samples every pair's lattice (flatPartnerSupports off).
+void BM_NarrowPhase_RestingBox(benchmark::State& state, ContactModel model, std::uint64_t budget, bool supports) {
+  const CollisionBody& box = restingBody(false);
+  const CollisionBody& slab = restingBody(true);
+  const Pose boxPose{Quat::Identity(), Vec3(0.37, 0.1, 0.748)};
+  QuerySettings s;
+  s.model = model;
+  s.budget.maxTests = budget;
+  s.contactSampling.flatPartnerSupports = supports;
+  QueryScratch scratch;
+  QueryResult result;
+  for (auto _ : state) {
+    queryContacts(box, boxPose, slab, Pose{}, s, scratch, result);
+    benchmark::DoNotOptimize(result.contacts.data());
+  }
+  state.counters["contacts"] = static_cast<double>(result.contacts.size());
+  state.counters["raw"] = static_cast<double>(result.rawContacts);
+  state.counters["tests"] = static_cast<double>(result.tests);
+  state.counters["finished"] = result.finished ? 1.0 : 0.0;
+}
+
 double percentile(std::vector<double> v, double q);  // accuracy harness, below
 
 // A deadline instead of a test count: the query must return by the deadline plus at most one
@@ -569,6 +611,17 @@ int main(int argc, char** argv) {
       benchmark::RegisterBenchmark(("BM_NarrowPhase_Bullet/" + prefix).c_str(), BM_NarrowPhase_Bullet, mesh, pose)
           ->Unit(benchmark::kMicrosecond);
 #endif
+    }
+  }
+  for (ContactModel model : {ContactModel::kCfm, ContactModel::kContactTree, ContactModel::kExact}) {
+    for (std::uint64_t budget : {std::uint64_t(16), kUnlimitedTests}) {
+      const std::string name = "BM_NarrowPhase_RestingBox/" + std::string(contactModelName(model)) + "/" +
+                               (budget == kUnlimitedTests ? std::string("unlimited") : std::to_string(budget));
+      benchmark::RegisterBenchmark(name.c_str(), BM_NarrowPhase_RestingBox, model, budget, true)
+          ->Unit(benchmark::kMicrosecond);
+      if (model == ContactModel::kContactTree)
+        benchmark::RegisterBenchmark((name + "/lattice").c_str(), BM_NarrowPhase_RestingBox, model, budget, false)
+            ->Unit(benchmark::kMicrosecond);
     }
   }
   benchmark::Initialize(&argc, argv);
