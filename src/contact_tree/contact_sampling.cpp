@@ -430,16 +430,17 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
   // along S's surface to its deepest point (curved cells). Where S's cell has no support points
   // (below kCellSupportMaxDepth), the lattice below answers.
   const std::span<const Vec3> supports = treeS.cellSupports(cellS.node);
+  // A support point p of S's cell that lies in O's cell and inside O becomes a sample.
+  auto sampleSupport = [&](const Vec3& p, bool flatO) {
+    const Vec3 pO = xfOFromS.apply(p);
+    if (!insideCell(treeO, cellO, pO)) return;
+    if (treeO.sample(pO, settings.maxDepth).distance > settings.marginAbs) return;
+    SurfacePoint surface;
+    if (surfacePointAt(treeS, settings.maxDepth, p, surface)) samplePoint(p, surface, 1, true, flatO);
+  };
   const bool flatPartner = settings.flatPartnerSupports && !supports.empty() && treeO.isFlatSurface(cellO.node);
   if (flatPartner) {
-    for (const Vec3& p : supports) {
-      const Vec3 pO = xfOFromS.apply(p);
-      if (!insideCell(treeO, cellO, pO)) continue;
-      if (treeO.sample(pO, settings.maxDepth).distance > settings.marginAbs) continue;
-      SurfacePoint surface;
-      if (!surfacePointAt(treeS, settings.maxDepth, p, surface)) continue;
-      samplePoint(p, surface, 1, true, true);
-    }
+    for (const Vec3& p : supports) sampleSupport(p, true);
     // A finished answer stops here. An interrupted one samples its coarse pair's lattice too:
     // a coarse cell's support points along 386 directions can all miss the lowest part of a
     // nearly flat face resting on the floor (a random fandisk drop rested 0.98 % of its
@@ -477,15 +478,8 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
       double farthest = -std::numeric_limits<double>::infinity();
       for (const Vec3& p : supports) farthest = std::max(farthest, towardO.dot(p));
       const double band = kSupportBandRel * h * towardO.norm();
-      for (const Vec3& p : supports) {
-        if (towardO.dot(p) < farthest - band) continue;
-        const Vec3 pO = xfOFromS.apply(p);
-        if (!insideCell(treeO, cellO, pO)) continue;
-        if (treeO.sample(pO, settings.maxDepth).distance > settings.marginAbs) continue;
-        SurfacePoint surface;
-        if (!surfacePointAt(treeS, settings.maxDepth, p, surface)) continue;
-        samplePoint(p, surface, 1, true, false);
-      }
+      for (const Vec3& p : supports)
+        if (towardO.dot(p) >= farthest - band) sampleSupport(p, false);
     }
   }
 }
