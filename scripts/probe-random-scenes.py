@@ -9,7 +9,8 @@ usage: scripts/probe-random-scenes.py SEED KINDS OUTDIR
   CLOD (build/bin/clod), CLOD_MESH_DIR (../shared/data/meshes).
 Prints one FAIL line per run that breaks a criterion of issue 17's point 1 (drops: the lowest
 vertex more than 1 % of the diagonal below the floor top at any frame, or still moving after
-5 s), NONMONO lines where the run's error grew with the budget, and a count. Each run's scene,
+5 s), NONMONO lines where the run's error grew with the budget, the deepest sink of the drops,
+and a count. Each run's scene,
 trajectory and summary stay in OUTDIR.
 """
 import json, math, os, random, subprocess, sys, csv, concurrent.futures as cf
@@ -197,4 +198,8 @@ if __name__=='__main__':
             ea, eb = v.get(a), v.get(b)
             if ea is None or eb is None: continue
             if not (eb <= ea + max(0.1*ea, 0.002)): print('NONMONO', k, f'{a}->{b}', f'{ea:.4f}->{eb:.4f}')
+    drops=[r for r in res if r[0].startswith('drop') and r[6]==r[6]]
+    if drops:
+        d=max(drops, key=lambda r: r[6])
+        print('deepest sink %.2f%% (%s %s b=%d us=%g %gHz)' % (d[6]*100, d[0], d[1], d[2], d[3], d[4]))
     print('runs', len(res), 'failing', sum(1 for r in res if r[5]))
