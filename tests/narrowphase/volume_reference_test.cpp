@@ -97,7 +97,10 @@ TEST(VolumeReference, ExactModelNormalFollowsTheVolumeGradientOnTheBunny) {
   std::mt19937_64 rng(2024);
   std::normal_distribution<double> gauss;
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const int poses = test::sanitizerRun() ? 3 : 12;
+  // Under the sanitizers 5 of the 12 poses: with 3 the median was the middle one of three
+  // single-pose errors (1.3, 2.7 and 2.2 deg), and a change of which 8 contacts the manifold
+  // keeps moved it across the bound while the 12-pose median went down (1.52 -> 1.35 deg).
+  const int poses = test::sanitizerRun() ? 5 : 12;
   std::vector<double> errors;
   for (int k = 0; k < poses; ++k) {
     const Quat rotation = Quat(u(rng), u(rng), u(rng), u(rng)).normalized();
