@@ -11,8 +11,9 @@
 // farthest toward it, i.e. near a support point of its cell in the direction of the other
 // body's normal; a box cell's support points are its corners. Tested against the other body's
 // field they give the deepest points of the coarse answer with the field's accuracy, whatever
-// the level (docs/contact-tree.md, "Support points"). Only a query interrupted at its budget
-// uses them (ContactSamplingSettings::supportPoints).
+// the level (docs/contact-tree.md, "Support points"). A query interrupted at its budget tests
+// them on its coarse pairs (ContactSamplingSettings::supportPoints), and every query answers a
+// pair whose other cell is flat with them (ContactSamplingSettings::flatPartnerSupports).
 //
 // Derived data, like the lookup grid: not in the bake file, rebuilt from the body's mesh when a
 // CollisionBody receives its contact tree.

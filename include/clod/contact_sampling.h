@@ -77,7 +77,7 @@ struct ContactSamplingSettings {
   /// Also test the support points of coarse cells (cell_support.h) where a pair has an inner
   /// cell: for an interrupted query's frontier, whose lattice misses contact regions smaller
   /// than its spacing. The query sets it when its traversal stopped at the budget; a finished
-  /// traversal's final cells are sampled as before.
+  /// traversal's final cells keep the lattice (but see flatPartnerSupports).
   bool supportPoints = false;
   /// Where O's cell is flat (ContactTree::isFlatSurface) and S's cell has support points, those
   /// inside O are the pair's samples: a flat partner is met first where S reaches farthest

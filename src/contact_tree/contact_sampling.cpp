@@ -467,8 +467,8 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
   // degrees off the floor's). Each tested point inside O descends along S's surface to its
   // deepest (slideIntoOther). They lie on the cell's closed boundary, so the own-cell test is
   // skipped; the test against O's cell keeps one frontier pair from repeating another's. Only
-  // for interrupted answers (ContactSamplingSettings::supportPoints): a finished traversal's
-  // final cells are small or flat, and the reference answer stays the lattice's.
+  // for interrupted answers (ContactSamplingSettings::supportPoints), and not where O's cell is
+  // flat: the flat-partner test above has tested every support point already.
   if (spread && settings.supportPoints && !flatPartner) {
     if (!supports.empty()) {
       Vec3 probe = xfOFromS.apply(treeS.cellCenter(cellS));
