@@ -212,6 +212,7 @@ bool slideIntoOther(const SlideFrame& fr, Vec3& pS, SurfacePoint& surface, Vec3&
   Vec3 bestS = pS, bestO = pO;
   SurfacePoint bestSurface = surface;
   ContactFieldSample best = f;
+  double bestAtSurface = distanceAtSurface(f, surface, fr.sFromO);
   for (int step = 0; step < kSlideSteps + kDescentSteps; ++step) {
     if (!entered && step >= kSlideSteps) break;
     // On a flat face the bottom is the cell's border: descending would pile a tilted box's samples
@@ -228,14 +229,13 @@ bool slideIntoOther(const SlideFrame& fr, Vec3& pS, SurfacePoint& surface, Vec3&
     pO = fr.xfOFromS.apply(pS);
     if (!insideCell(fr.treeO, fr.cellO, pO)) break;
     f = fr.treeO.sample(pO, fr.maxDepth);
+    const double atSurface = distanceAtSurface(f, surface, fr.sFromO);
     // Past the bottom, or on a plane O's field is level along (a box's corner on a floor, where
     // rounding alone made each step "deeper" and walked the corner's contact 2 cm inward).
-    if (entered && distanceAtSurface(f, surface, fr.sFromO) >
-                       distanceAtSurface(best, bestSurface, fr.sFromO) - kDescentGainRel * fr.treeO.errorAbs)
-      break;
+    if (entered && atSurface > bestAtSurface - kDescentGainRel * fr.treeO.errorAbs) break;
     if (f.distance <= fr.marginAbs) {
       entered = true;
-      bestS = pS, bestO = pO, bestSurface = surface, best = f;
+      bestS = pS, bestO = pO, bestSurface = surface, best = f, bestAtSurface = atSurface;
     }
   }
   if (!entered) return false;
