@@ -912,6 +912,14 @@ bool vertexOnFaceContacts(const PatchSide& patch, const PatchSide& faceted, cons
   const double tolerance = 1e-9 * (patch.body.diagonal() + faceted.body.diagonal());
   const bool facetedIsB = toward.dot(c.normal) > 0.0;
   const std::size_t before = out.size();
+  // For the edge-on-surface rule below: the depth-weighted sum of the pressed vertices' outward
+  // normals, the face the deepest one leaves through, and per face how far behind its plane the
+  // patch's vertices outside the body reach.
+  Vec3 normalSum = Vec3::Zero();
+  double deepest = 0.0;
+  std::size_t deepestFace = 0;
+  std::array<double, CollisionBody::kMaxSphereFaceNormals> outsideBehind;
+  outsideBehind.fill(-std::numeric_limits<double>::infinity());
   // A faceted patch's own vertices (few; its support set is empty), else the curved patch's
   // support set and its inner vertices (CollisionBody::sphereInnerVertices, only a non-convex
   // patch has them): the flank of a bump can be inside the convex body while the hull's vertices
@@ -928,13 +936,23 @@ bool vertexOnFaceContacts(const PatchSide& patch, const PatchSide& faceted, cons
       bool inside = true;
       std::size_t pressed = faces.size(), nearest = 0;
       double depth = std::numeric_limits<double>::infinity(), nearestDepth = depth;
-      for (std::size_t k = 0; k < faces.size() && inside; ++k) {
+      std::array<double, CollisionBody::kMaxSphereFaceNormals> behind;
+      for (std::size_t k = 0; k < faces.size(); ++k) {
         const double d = halfSpaces[k].second - halfSpaces[k].first.dot(v);
-        inside = d > tolerance;
+        behind[k] = d;
+        inside = inside && d > tolerance;
         if (-halfSpaces[k].first.dot(normal) >= kMinFacingCos && d < depth) depth = d, pressed = k;
         if (d < nearestDepth) nearestDepth = d, nearest = k;
       }
-      if (!inside) continue;
+      if (!inside) {
+        // Only where the surface rises toward the body: beyond a face it faces (a bump's near
+        // flank in front of a box), not falling away from it (the far flank past the bump's top).
+        bool rising = false;
+        for (std::size_t k = 0; k < faces.size(); ++k) rising = rising || (behind[k] < 0.0 && halfSpaces[k].first.dot(normal) < 0.0);
+        if (rising)
+          for (std::size_t k = 0; k < faces.size(); ++k) outsideBehind[k] = std::max(outsideBehind[k], behind[k]);
+        continue;
+      }
       // No face it faces, or one much deeper than the nearest face: the nearest face. A vertex
       // arrives at most a fraction of a percent of the smaller diagonal deep per substep (the
       // world's arrival rule), so an exit kMaxDetourRel deeper than the nearest one is not where it
@@ -948,6 +966,8 @@ bool vertexOnFaceContacts(const PatchSide& patch, const PatchSide& faceted, cons
       ci.normal = facetedIsB ? exit : Vec3(-exit);
       ci.point = v + 0.5 * depth * exit;
       ci.depth = depth;
+      normalSum += depth * normal;
+      if (depth > deepest) deepest = depth, deepestFace = pressed;
       // Exact only against the whole body's faces: "behind every face plane of a leaf's patch" is
       // no proof of being inside (an icosphere's leaf holds a few of its 320 faces; a vertex
       // behind them may lie outside the body), so there the pair's bound stays (measured:
@@ -955,6 +975,77 @@ bool vertexOnFaceContacts(const PatchSide& patch, const PatchSide& faceted, cons
       ci.errorBound = whole ? 0.0 : c.errorBound;
       out.push_back(ci);
     }
+  }
+  // Edge on surface. Where the patch also reaches behind the deepest vertex's exit plane outside
+  // the body, its surface passes under an edge of the body (a box's front edge on a bump's flank,
+  // 4-15 mm deep, the bump rising in front of the box): pushing each vertex out through the
+  // face lifted the box straight up where the exact model pushes it back along the flank, and
+  // it crossed the bump without turning (flat-contact: 7 deg heading error). Then the vertices leave
+  // along the patch's own surface direction instead -- the depth-weighted mean of their outward
+  // normals, a one-sided estimate of the intersection volume's gradient (the exact model's
+  // normal) -- each at the depth it needs along it. A patch meeting one face only (a bunny on a
+  // floor, whose rim vertices' normals lie along the floor) keeps the faces. Where the mean
+  // turns more than 60 deg from a vertex's face, that vertex keeps its face.
+  const bool underAnEdge = out.size() > before && outsideBehind[deepestFace] > tolerance;
+  const double sumLength = normalSum.norm();
+  if (underAnEdge && sumLength > 0.0) {
+    const Vec3 axis = -normalSum / sumLength;  // the direction the patch's vertices leave along
+    for (std::size_t i = before; i < out.size(); ++i) {
+      Contact& ci = out[i];
+      const Vec3 exit = facetedIsB ? ci.normal : Vec3(-ci.normal);
+      if (axis.dot(exit) < kMinFacingCos) continue;
+      const Vec3 v = ci.point - 0.5 * ci.depth * exit;
+      double along = std::numeric_limits<double>::infinity();  // travel along axis to leave the body
+      for (std::size_t k = 0; k < faces.size(); ++k) {
+        const double rate = halfSpaces[k].first.dot(axis);
+        if (rate > 1e-9) along = std::min(along, (halfSpaces[k].second - halfSpaces[k].first.dot(v)) / rate);
+      }
+      if (!std::isfinite(along)) continue;
+      ci.normal = facetedIsB ? axis : Vec3(-axis);
+      ci.depth = along;
+      ci.point = v + 0.5 * along * axis;
+    }
+  }
+  return out.size() > before;
+}
+
+// A convex patch's corners behind a flat patch (all its triangles in one plane) of a non-convex
+// body, each over one of that patch's triangles: the plane is the surface there, so a corner's
+// depth below it is its exact penetration, along the plane's normal (error bound 0). A flat piece
+// of a floor with more vertices than a faceted patch keeps counted as a curved patch, bounded by
+// its sphere: a box resting on one bottom edge, 1 mm into the floor, got contacts along the
+// floor's normal at the floor sphere's centre and across the box's underside, 0.2-0.3 m from the
+// edge, with the spheres' error bound; their friction turned the box the wrong way over the
+// flat-contact bump (docs/narrow-phase.md, "Flat patches"). Returns false when it added nothing.
+bool cornersOverFlatPatchContacts(const PatchSide& flat, const PatchSide& convex, bool flatIsB, const Contact& c,
+                                  std::vector<Contact>& out) {
+  const Vec3 nLocal = flat.body.sphereFaceNormals(flat.sphere)[0].cast<double>();
+  const Vec3 n = flat.rotToA ? Vec3(*flat.rotToA * nLocal) : nLocal;  // outward, A frame
+  const TriangleMesh& mesh = flat.body.mesh();
+  const std::span<const std::uint32_t> triangles = flat.body.sphereTree().triangles(flat.sphere);
+  if (triangles.empty()) return false;
+  const double offsetLocal = nLocal.dot(mesh.corner(triangles[0], 0));
+  const double tolerance = 1e-9 * (flat.body.diagonal() + convex.body.diagonal());
+  const std::size_t before = out.size();
+  for (std::uint32_t id : convex.body.spherePatchVertices(convex.sphere)) {
+    const Vec3 v = convex.toA(convex.body.mesh().vertices[id]);
+    const Vec3 vLocal = flat.rotToA ? Vec3(flat.rotToA->transpose() * (v - flat.shift)) : v;  // flat body's frame
+    const double depth = offsetLocal - nLocal.dot(vLocal);
+    if (!(depth > tolerance)) continue;
+    const Vec3 onPlane = vLocal + depth * nLocal;  // the corner's foot on the plane
+    bool over = false;
+    for (std::size_t k = 0; k < triangles.size() && !over; ++k) {
+      const Vec3 a = mesh.corner(triangles[k], 0), b = mesh.corner(triangles[k], 1), d = mesh.corner(triangles[k], 2);
+      over = nLocal.dot((b - a).cross(onPlane - a)) >= 0.0 && nLocal.dot((d - b).cross(onPlane - b)) >= 0.0 &&
+             nLocal.dot((a - d).cross(onPlane - d)) >= 0.0;
+    }
+    if (!over) continue;
+    Contact ci = c;
+    ci.normal = flatIsB ? n : Vec3(-n);
+    ci.point = v + 0.5 * depth * n;
+    ci.depth = depth;
+    ci.errorBound = 0.0;
+    out.push_back(ci);
   }
   return out.size() > before;
 }
@@ -1066,6 +1157,22 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
     // single patch contact held the Figure 6 bunny 95 deg from the exact run's pose; with their
     // vertices, 13 deg (`clod experiment landing`).
     const bool convexA = bodyA.isConvexPolyhedron(), convexB = bodyB.isConvexPolyhedron();
+    // A flat patch of a non-convex body against a convex patch: the convex corners over it and its
+    // own vertices inside the convex body are the whole contact; none of either means the convex
+    // body's underside does not reach into this piece (an edge lying across it is held by the
+    // corners over the neighbouring pieces).
+    const bool flatA = !convexA && sideB.faceted && convexB && bodyA.sphereFaceNormals(p.a).size() == 1;
+    const bool flatB = !flatA && !convexB && sideA.faceted && convexA && bodyB.sphereFaceNormals(p.b).size() == 1;
+    if (flatA) {
+      cornersOverFlatPatchContacts(sideA, sideB, false, c, out);
+      vertexOnFaceContacts(sideA, sideB, c.normal, c, out);
+      continue;
+    }
+    if (flatB) {
+      cornersOverFlatPatchContacts(sideB, sideA, true, c, out);
+      vertexOnFaceContacts(sideB, sideA, -c.normal, c, out);
+      continue;
+    }
     if ((!sideA.faceted || !convexA) && sideB.faceted && convexB && vertexOnFaceContacts(sideA, sideB, c.normal, c, out))
       continue;
     if ((!sideB.faceted || !convexB) && sideA.faceted && convexA && vertexOnFaceContacts(sideB, sideA, -c.normal, c, out))

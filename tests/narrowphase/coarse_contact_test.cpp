@@ -453,14 +453,19 @@ TriangleMesh makeBumpedSlab(double halfX, double halfY, double bx, double height
 
 // A unit cube resting on a bumped ground (a 4 cm bump of radius 20 cm, the ground of `clod
 // experiment flat-contact`), 0.5 mm into its flat part, with its front face over the bump's
-// flank (the bump's top still outside the box) or over its top. Oracle: every ground vertex,
-// checked one by one against the box (brute force); its depth is its height above the box's
-// bottom face. cfm must give the deepest of them as a contact at its own depth. Before, a
-// curved patch of the ground offered only its convex hull's vertices -- the bump's top and the
-// patch's rim -- so the flank under the box's edge gave no contact, the box ploughed into the
-// bump and was thrown up when the top arrived (flat-contact: 239 mm rms from the exact track).
-TEST(CoarseContacts, BoxOverABumpsFlankGetsTheDeepestGroundVertexAsAContact) {
-  const double bx = 0.6, bumpHeight = 0.04, bumpRadius = 0.2, sunk = 0.0005;
+// flank (the bump's top still outside the box) or over its top. Two oracles. (1) By brute force
+// over every ground vertex inside the box: cfm's deepest contact must reach at least the deepest
+// vertex's height (before, a curved patch of the ground offered only its convex hull's vertices
+// -- the bump's top and the patch's rim -- so the flank under the box's edge gave no contact,
+// the box ploughed into the bump and was thrown up when the top arrived: flat-contact, 239 mm rms
+// from the exact track). (2) From the bump's analytic height h(r): the minimum translation that
+// lifts the box's bottom face clear of the bump over its whole footprint, searched over
+// directions tilted back from the vertical by 0-30 deg in 0.05 deg steps (bisection on the
+// travel along each). Every normal must lie between the vertical and that direction: the flank
+// under the front edge pushes the box up and back, never forward (with straight-up normals the
+// box crossed the bump without turning, 7 deg off the exact model's heading).
+TEST(CoarseContacts, BoxOverABumpsFlankIsPushedUpAndBackFromTheDeepestGroundVertex) {
+  const double bx = 0.6, by = 0.0, bumpHeight = 0.04, bumpRadius = 0.2, sunk = 0.0005;
   static const CollisionBody ground = [&] {
     BakeSettings settings;
     settings.sphereTree.method = SphereTreeMethod::kOctree;
@@ -473,35 +478,114 @@ TEST(CoarseContacts, BoxOverABumpsFlankGetsTheDeepestGroundVertexAsAContact) {
   // Rounding of face planes from float face normals over a few metres, relative to the ground's
   // diagonal (~3.8 m): 1e-6 of it is far below the millimetres the test tells apart.
   const double rounding = 1e-6 * ground.diagonal();
+  // The oracle's direction step (0.05 deg), and the 2 cm tessellation of the bump, whose flank
+  // turns by up to 1 deg between grid lines.
+  const double angleSlack = 1.0 * kDegree;
+  // Highest point of the bump under a footprint reaching x0 along +x (the box spans y = -0.45 ..
+  // 0.55 over the bump's centre line y = by, so the row through the centre is the highest).
+  auto highestUnder = [&](double x0) {
+    const double r = std::max(0.0, bx - x0);
+    return r < bumpRadius ? 0.5 * bumpHeight * (1.0 + std::cos(kPi * r / bumpRadius)) : 0.0;
+  };
   int cases = 0;
   // Front face at r = 0.14, 0.1, 0.06 before the bump's centre (the top outside the box), and
   // past it (the top under the face).
   for (double front : {bx - 0.14, bx - 0.1, bx - 0.06, bx + 0.1}) {
-    const Pose pose{Quat::Identity(), Vec3(front - 0.5, 0.05, 0.5 - sunk)};
+    const Pose pose{Quat::Identity(), Vec3(front - 0.5, by + 0.05, 0.5 - sunk)};
     double deepest = 0.0;
     for (const Vec3& v : ground.mesh().vertices) {
       const Vec3 local = pose.applyInverse(v);
       if ((local.array().abs() < 0.5).all()) deepest = std::max(deepest, local.z() + 0.5);
     }
     ASSERT_GT(deepest, 4.0 * sunk) << "front " << front << ": the bump's flank is under the box";
+    double minTravel = std::numeric_limits<double>::infinity(), minTilt = 0.0;
+    for (double tilt = 0.0; tilt <= 30.0 * kDegree; tilt += 0.05 * kDegree) {
+      double lo = 0.0, hi = 0.2;
+      for (int k = 0; k < 60; ++k) {
+        const double t = 0.5 * (lo + hi);
+        const bool clear = t * std::cos(tilt) - sunk >= highestUnder(front - t * std::sin(tilt));
+        (clear ? hi : lo) = t;
+      }
+      if (hi < minTravel) minTravel = hi, minTilt = tilt;
+    }
     for (bool groundIsA : {true, false}) {
       QuerySettings settings;  // unlimited budget: the ground's leaves against the box
       settings.model = ContactModel::kCfm;
       const QueryResult r = groundIsA ? queryContacts(ground, Pose{}, cube, pose, settings)
                                       : queryContacts(cube, pose, ground, Pose{}, settings);
-      const std::string what = "front " + std::to_string(front) + (groundIsA ? ", ground is A" : ", ground is B");
+      const std::string what = "front " + std::to_string(front) + (groundIsA ? ", ground is A" : ", ground is B") +
+                               " (minimum translation " + std::to_string(minTravel) + " m, tilted " +
+                               std::to_string(minTilt / kDegree) + " deg)";
       double deepestContact = 0.0;
+      Vec3 deepestPush = Vec3::UnitZ();
       for (const Contact& c : r.contacts) {
-        // Normal from B to A: up when the box is A.
-        EXPECT_LT(angleBetween(groundIsA ? Vec3(-c.normal) : c.normal, Vec3::UnitZ()), 1e-6) << what;
-        deepestContact = std::max(deepestContact, c.depth);
+        // The direction the box is pushed: along the normal (B to A) when the box is A.
+        const Vec3 push = groundIsA ? Vec3(-c.normal) : c.normal;
+        EXPECT_LE(angleBetween(push, Vec3::UnitZ()), minTilt + angleSlack) << what;
+        EXPECT_LE(push.x(), rounding) << what << ": pushed forward, into the bump";
+        if (c.depth > deepestContact) deepestContact = c.depth, deepestPush = push;
       }
-      EXPECT_NEAR(deepestContact, deepest, rounding) << what;
+      EXPECT_GE(deepestContact, deepest - rounding) << what;
+      // On the flank the push tilts back by at least a quarter of the minimum translation's tilt
+      // (the flat part's vertices, pressed 0.5 mm, dilute the flank's normals in the mean);
+      // straight up, the box crossed the bump without turning.
+      if (front < bx) {
+        EXPECT_GE(angleBetween(deepestPush, Vec3::UnitZ()), 0.25 * minTilt) << what;
+      }
       ++cases;
     }
   }
   EXPECT_EQ(cases, 8);
 }
+
+// A unit cube rolled 2 deg about x, its low bottom edge 1 mm into the flat part of the bumped
+// ground (a non-convex mesh, so its flat leaves are patches of a larger surface). Oracle: the
+// cube's two low corners, by construction -- their positions and their depth below the plane
+// z = 0. cfm must give exactly them, along the floor's normal, with error bound 0. Before, the
+// floor's flat leaves (more vertices than a faceted patch keeps) counted as curved patches: the
+// contacts stood along the floor normal at the floor spheres' centres, up to 0.24 m inside the
+// edge, with the spheres' error bound (1.3 m), and turned a box riding over the bump the wrong
+// way (flat-contact: cfm 58 mm rms from the exact track).
+TEST(CoarseContacts, CubeOnOneEdgeOverAFlatPieceOfANonConvexFloorRestsOnItsTwoLowCorners) {
+  static const CollisionBody ground = [] {
+    BakeSettings settings;
+    settings.sphereTree.method = SphereTreeMethod::kOctree;
+    settings.sphereTree.depth = 3;
+    settings.measureFit = false;
+    settings.buildContactTree = false;
+    return CollisionBody::fromBake(bakeMesh(makeBumpedSlab(1.6, 1.0, 0.6, 0.04, 0.2), settings).contents);
+  }();
+  const CollisionBody& cube = slabBodies().cube;
+  const double roll = 2.0 * kDegree, sunk = 0.001;
+  const Quat q(Eigen::AngleAxisd(roll, Vec3::UnitX()));
+  // The low edge is the one at local y = -0.5, z = -0.5; lift the centre so it lies `sunk` deep.
+  const Vec3 lowLocal(0.0, -0.5, -0.5);
+  const Pose pose{q, Vec3(-0.4, 0.1, -sunk - (q * lowLocal).z())};
+  const Vec3 corners[2] = {pose.apply(Vec3(-0.5, -0.5, -0.5)), pose.apply(Vec3(0.5, -0.5, -0.5))};
+  // Float face normals and bake rounding over the ground's ~3.8 m diagonal.
+  const double rounding = 1e-6 * ground.diagonal();
+  for (bool groundIsA : {true, false}) {
+    QuerySettings settings;
+    settings.model = ContactModel::kCfm;
+    const QueryResult r = groundIsA ? queryContacts(ground, Pose{}, cube, pose, settings)
+                                    : queryContacts(cube, pose, ground, Pose{}, settings);
+    const std::string what = groundIsA ? "ground is A" : "ground is B";
+    ASSERT_EQ(r.contacts.size(), 2u) << what;
+    bool found[2] = {false, false};
+    for (const Contact& c : r.contacts) {
+      const Vec3 push = groundIsA ? Vec3(-c.normal) : c.normal;
+      EXPECT_LT(angleBetween(push, Vec3::UnitZ()), 1e-6) << what;
+      EXPECT_NEAR(c.depth, sunk, rounding) << what;
+      EXPECT_EQ(c.errorBound, 0.0) << what;
+      for (int k = 0; k < 2; ++k) {
+        // The point lies halfway along the depth, above the corner.
+        if ((c.point - (corners[k] + 0.5 * sunk * Vec3::UnitZ())).norm() < rounding) found[k] = true;
+      }
+    }
+    EXPECT_TRUE(found[0] && found[1]) << what;
+  }
+}
+
 // A contact-tree sample half a coarse cell below one face of a thin body lies past its far face,
 // outside it: the other body's field there is no penetration. A flat box (1.08 x 0.6 x 0.45) on
 // a slab, tipped onto one long edge, got contacts 5-10 cm "deep" at 16-42 tests from such points
