@@ -400,6 +400,42 @@ TEST(CoarseContacts, CurvedPatchesApartAlongTheCentreLineGiveNoContact) {
 }
 
 
+// Two unit icospheres (320 triangles; curved patches down to level 2 of an 8-ary octree tree)
+// 2 % of the radius into each other along a random line, resolved at level 1 (an interrupted
+// answer's curved pairs). Oracle: the lens where the two balls overlap. Every cfm contact must
+// lie in it, grown by one edge of the tessellation (0.13 of the radius: where the vertices
+// nearest the centre line can stand). Before, a curved pair's point started from A's sphere
+// centre: contacts stood up to 0.24 radii outside the lens, 0.3 off the centre line in the
+// median -- where the bodies do not touch.
+TEST(CoarseContacts, TwoCurvedPatchesTouchInsideTheirLens) {
+  static const CollisionBody ball = [] {
+    BakeSettings settings;
+    settings.sphereTree.method = SphereTreeMethod::kOctree;
+    settings.sphereTree.depth = 3;
+    settings.measureFit = false;
+    settings.buildContactTree = false;
+    return CollisionBody::fromBake(bakeMesh(makeIcosphere(1.0, 3), settings).contents);
+  }();
+  const double edge = 0.13, overlap = 0.02;
+  std::mt19937_64 rng(5);
+  int contacts = 0;
+  for (int trial = 0; trial < (test::sanitizerRun() ? 10 : 60); ++trial) {
+    const Pose poseA{test::randomPose(rng, 0.0).rotation, Vec3::Zero()};
+    const Vec3 line = test::randomPose(rng, 1.0).translation.normalized();
+    const Pose poseB{test::randomPose(rng, 0.0).rotation, (2.0 - overlap) * line};
+    QuerySettings settings = settingsFor(ContactModel::kCfm, kUnlimitedTests);
+    settings.maxLevel = 1;
+    const QueryResult r = queryContacts(ball, poseA, ball, poseB, settings);
+    for (const Contact& c : r.contacts) {
+      const double outside = std::max(c.point.norm(), (c.point - poseB.translation).norm()) - 1.0;
+      EXPECT_LE(outside, edge) << "trial " << trial << ": point " << c.point.transpose();
+      ++contacts;
+    }
+  }
+  EXPECT_GE(contacts, test::sanitizerRun() ? 10 : 60);  // every pose touches: the test must see contacts
+}
+
+
 // A closed slab whose top (z = 0) is a height field with a smooth bump h(r) = H (1 + cos(pi r /
 // R)) / 2 for r < R around (bx, 0): 2 cm cells within the bump's square, 10 cm elsewhere, side
 // walls and a bottom fanned from its centre; counter-clockwise seen from outside.
