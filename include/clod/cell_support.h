@@ -1,8 +1,9 @@
 #pragma once
 // Support points of a contact tree's coarse cells: for each surface cell down to a depth, the
 // points of the mesh's surface inside the cell (the triangles clipped to the cube) that lie
-// farthest along each of 386 directions (a 9 x 9 grid on each face of a cube), without
-// repeats.
+// farthest along each of 386 directions (a 9 x 9 grid on each face of a cube) and the vertices
+// of that clipped surface's convex hull (so every direction's farthest point is among them),
+// without repeats.
 //
 // Why: an interrupted contact-tree query answers from coarse cell pairs, whose samples -- a
 // lattice on the cell's plane, moved onto the surface -- are spread over the whole cell and

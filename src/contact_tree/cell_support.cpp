@@ -5,6 +5,8 @@
 #include <limits>
 #include <vector>
 
+#include "geometry/convex_hull.h"
+
 namespace clod {
 namespace {
 
@@ -47,6 +49,11 @@ void clipPolygon(std::vector<Vec3>& poly, std::vector<Vec3>& scratch, int axis, 
   poly.swap(scratch);
 }
 
+
+
+// A cell whose clipped surface's hull has more vertices keeps the grid's extremes alone.
+constexpr std::size_t kMaxCellHullVertices = 4096;
+
 struct Builder {
   const ContactTree& tree;
   const TriangleMesh& mesh;
@@ -56,6 +63,8 @@ struct Builder {
   std::vector<Vec3> poly, scratch;
   std::vector<double> best;
   std::vector<Vec3> arg;
+  std::vector<Vec3> clipped;  // the corners of the cell's clipped triangles
+  std::vector<std::uint32_t> hull;
 
   void visit(const ContactCell& cell, const std::vector<std::uint32_t>& triangles) {
     const Vec3 lo = tree.cellMin(cell);
@@ -64,6 +73,7 @@ struct Builder {
     arg.resize(dirs.size());
     std::vector<std::uint32_t> inside;
     inside.reserve(triangles.size());
+    clipped.clear();
     for (std::uint32_t t : triangles) {
       poly.assign({mesh.corner(t, 0), mesh.corner(t, 1), mesh.corner(t, 2)});
       for (int axis = 0; axis < 3 && !poly.empty(); ++axis) {
@@ -72,6 +82,7 @@ struct Builder {
       }
       if (poly.empty()) continue;
       inside.push_back(t);
+      clipped.insert(clipped.end(), poly.begin(), poly.end());
       for (const Vec3& p : poly)
         for (std::size_t k = 0; k < dirs.size(); ++k) {
           const double s = dirs[k].dot(p);
@@ -85,6 +96,17 @@ struct Builder {
       for (const Vec3& q : out) repeat = repeat || q == arg[k];
       if (!repeat) out.push_back(arg[k]);
     }
+    // Plus the vertices of the clipped surface's convex hull: every point extreme in some
+    // direction, not only in the 386 of the grid. Near a floor's normal the grid's directions
+    // picked the rim of each of spot's hooves, 4 mm above its lowest point (a nearly flat sole
+    // tilted by less than the grid's 4.5 degrees), and an interrupted answer missed a front foot
+    // 0.3 mm into the floor: spot toppled at 60 Hz (docs/contact-tree.md, "Support points").
+    if (detail::convexHullVertices(clipped, kMaxCellHullVertices, hull))
+      for (std::uint32_t id : hull) {
+        bool repeat = false;
+        for (const Vec3& q : out) repeat = repeat || q == clipped[id];
+        if (!repeat) out.push_back(clipped[id]);
+      }
     if (cell.depth >= maxDepth || tree.isLeaf(cell.node)) return;
     for (std::uint32_t octant = 0; octant < 8; ++octant) visit(tree.childCell(cell, octant), inside);
   }
@@ -101,7 +123,7 @@ void deriveCellSupports(ContactTree& tree, const TriangleMesh& mesh, std::uint32
   std::vector<std::vector<Vec3>> perNode(nodes);
   std::vector<std::uint32_t> all(mesh.triangleCount());
   for (std::uint32_t t = 0; t < mesh.triangleCount(); ++t) all[t] = t;
-  Builder builder{tree, mesh, maxDepth, perNode, supportDirections(), {}, {}, {}, {}};
+  Builder builder{tree, mesh, maxDepth, perNode, supportDirections(), {}, {}, {}, {}, {}, {}};
   builder.visit(tree.rootCell(), all);
   tree.supportOffsets.reserve(nodes + 1);
   tree.supportOffsets.push_back(0);

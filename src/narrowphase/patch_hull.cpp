@@ -2,11 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 
-#include <libqhull_r/qhull_ra.h>
+#include "geometry/convex_hull.h"
 
 namespace clod::detail {
 namespace {
@@ -35,44 +33,15 @@ double support(const TriangleMesh& mesh, std::span<const std::uint32_t> ids, con
   return best;
 }
 
-// The vertices of the convex hull of `ids` (qhull; QJ joggles coplanar and cospherical input by
-// ~1e-11 of its size, so a vertex on a flat hull face may be left out: it is never more extreme
-// than the face's corners). False when qhull fails or the hull has more than maxVertices.
+// The vertices of the convex hull of `ids` (detail::convexHullVertices). False when qhull fails
+// or the hull has more than maxVertices.
 bool hullVertices(const TriangleMesh& mesh, std::span<const std::uint32_t> ids, std::size_t maxVertices,
                   std::vector<std::uint32_t>& out) {
-  if (ids.size() < 4) return false;
-  std::vector<coordT> coords(3 * ids.size());
-  for (std::size_t i = 0; i < ids.size(); ++i)
-    for (int a = 0; a < 3; ++a) coords[3 * i + a] = mesh.vertices[ids[i]][a];
-  // qhull reports errors on a FILE*: capture them in memory so the library never prints.
-  char* errorText = nullptr;
-  std::size_t errorSize = 0;
-  FILE* errorStream = open_memstream(&errorText, &errorSize);
-  if (errorStream == nullptr) return false;
-  qhT qhStorage;
-  qhT* qh = &qhStorage;
-  qh_zero(qh, errorStream);
-  char flags[] = "qhull QJ";
-  const int exitCode = qh_new_qhull(qh, 3, static_cast<int>(ids.size()), coords.data(), False, flags, nullptr, errorStream);
-  bool ok = exitCode == 0 && std::size_t(qh->num_vertices) <= maxVertices;
-  if (ok) {
-    out.clear();
-    vertexT* vertex;
-    FORALLvertices {
-      const int id = qh_pointid(qh, vertex->point);
-      if (id < 0 || std::size_t(id) >= ids.size()) {
-        ok = false;
-        break;
-      }
-      out.push_back(ids[std::size_t(id)]);
-    }
-  }
-  qh_freeqhull(qh, !qh_ALL);
-  int curlong = 0, totlong = 0;
-  qh_memfreeshort(qh, &curlong, &totlong);
-  std::fclose(errorStream);
-  std::free(errorText);
-  return ok;
+  std::vector<Vec3> points(ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) points[i] = mesh.vertices[ids[i]];
+  if (!convexHullVertices(points, maxVertices, out)) return false;
+  for (std::uint32_t& id : out) id = ids[id];
+  return true;
 }
 
 }  // namespace
