@@ -34,15 +34,21 @@ constexpr double kDegree = kPi / 180.0;
 
 double angleBetween(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
 
-// The bake of tests/dynamics/world_test.cpp (octree sphere-tree of depth 3, default closest
-// feature map, contact tree of depth 6), so these are the trees the box-drop test runs on.
-CollisionBody bakeLikeTheWorldTest(const TriangleMesh& mesh) {
+// An octree sphere-tree of depth 3 and the default closest feature map, no contact tree: the
+// cfm model's view of a body as `clod experiment flat-contact` bakes it.
+CollisionBody octreeBodyForCfm(const TriangleMesh& mesh) {
   BakeSettings settings;
   settings.sphereTree.method = SphereTreeMethod::kOctree;
   settings.sphereTree.depth = 3;
   settings.measureFit = false;
   settings.buildContactTree = false;
-  CollisionBody body = CollisionBody::fromBake(bakeMesh(mesh, settings).contents);
+  return CollisionBody::fromBake(bakeMesh(mesh, settings).contents);
+}
+
+// The bake of tests/dynamics/world_test.cpp (octree sphere-tree of depth 3, default closest
+// feature map, contact tree of depth 6), so these are the trees the box-drop test runs on.
+CollisionBody bakeLikeTheWorldTest(const TriangleMesh& mesh) {
+  CollisionBody body = octreeBodyForCfm(mesh);
   ContactTreeSettings ct;
   ct.maxDepth = 6;
   body.setContactTree(buildContactTree(MeshDistance(mesh), ct));
@@ -408,14 +414,7 @@ TEST(CoarseContacts, CurvedPatchesApartAlongTheCentreLineGiveNoContact) {
 // centre: contacts stood up to 0.24 radii outside the lens, 0.3 off the centre line in the
 // median -- where the bodies do not touch.
 TEST(CoarseContacts, TwoCurvedPatchesTouchInsideTheirLens) {
-  static const CollisionBody ball = [] {
-    BakeSettings settings;
-    settings.sphereTree.method = SphereTreeMethod::kOctree;
-    settings.sphereTree.depth = 3;
-    settings.measureFit = false;
-    settings.buildContactTree = false;
-    return CollisionBody::fromBake(bakeMesh(makeIcosphere(1.0, 3), settings).contents);
-  }();
+  static const CollisionBody ball = octreeBodyForCfm(makeIcosphere(1.0, 3));
   const double edge = 0.13, overlap = 0.02;
   std::mt19937_64 rng(5);
   int contacts = 0;
@@ -502,14 +501,7 @@ TriangleMesh makeBumpedSlab(double halfX, double halfY, double bx, double height
 // box crossed the bump without turning, 7 deg off the exact model's heading).
 TEST(CoarseContacts, BoxOverABumpsFlankIsPushedUpAndBackFromTheDeepestGroundVertex) {
   const double bx = 0.6, by = 0.0, bumpHeight = 0.04, bumpRadius = 0.2, sunk = 0.0005;
-  static const CollisionBody ground = [&] {
-    BakeSettings settings;
-    settings.sphereTree.method = SphereTreeMethod::kOctree;
-    settings.sphereTree.depth = 3;
-    settings.measureFit = false;
-    settings.buildContactTree = false;
-    return CollisionBody::fromBake(bakeMesh(makeBumpedSlab(1.6, 1.0, bx, bumpHeight, bumpRadius), settings).contents);
-  }();
+  static const CollisionBody ground = octreeBodyForCfm(makeBumpedSlab(1.6, 1.0, bx, bumpHeight, bumpRadius));
   const CollisionBody& cube = slabBodies().cube;
   // Rounding of face planes from float face normals over a few metres, relative to the ground's
   // diagonal (~3.8 m): 1e-6 of it is far below the millimetres the test tells apart.
@@ -583,14 +575,7 @@ TEST(CoarseContacts, BoxOverABumpsFlankIsPushedUpAndBackFromTheDeepestGroundVert
 // edge, with the spheres' error bound (1.3 m), and turned a box riding over the bump the wrong
 // way (flat-contact: cfm 58 mm rms from the exact track).
 TEST(CoarseContacts, CubeOnOneEdgeOverAFlatPieceOfANonConvexFloorRestsOnItsTwoLowCorners) {
-  static const CollisionBody ground = [] {
-    BakeSettings settings;
-    settings.sphereTree.method = SphereTreeMethod::kOctree;
-    settings.sphereTree.depth = 3;
-    settings.measureFit = false;
-    settings.buildContactTree = false;
-    return CollisionBody::fromBake(bakeMesh(makeBumpedSlab(1.6, 1.0, 0.6, 0.04, 0.2), settings).contents);
-  }();
+  static const CollisionBody ground = octreeBodyForCfm(makeBumpedSlab(1.6, 1.0, 0.6, 0.04, 0.2));
   const CollisionBody& cube = slabBodies().cube;
   const double roll = 2.0 * kDegree, sunk = 0.001;
   const Quat q(Eigen::AngleAxisd(roll, Vec3::UnitX()));
