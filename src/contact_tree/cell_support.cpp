@@ -49,7 +49,12 @@ void clipPolygon(std::vector<Vec3>& poly, std::vector<Vec3>& scratch, int axis, 
   poly.swap(scratch);
 }
 
-
+// Appends p unless `out` holds it already (the few hundred points of a cell keep their order).
+void appendUnique(std::vector<Vec3>& out, const Vec3& p) {
+  for (const Vec3& q : out)
+    if (q == p) return;
+  out.push_back(p);
+}
 
 // A cell whose clipped surface's hull has more vertices keeps the grid's extremes alone.
 constexpr std::size_t kMaxCellHullVertices = 4096;
@@ -91,22 +96,14 @@ struct Builder {
     }
     if (inside.empty()) return;
     std::vector<Vec3>& out = perNode[cell.node];
-    for (std::size_t k = 0; k < dirs.size(); ++k) {
-      bool repeat = false;
-      for (const Vec3& q : out) repeat = repeat || q == arg[k];
-      if (!repeat) out.push_back(arg[k]);
-    }
+    for (const Vec3& p : arg) appendUnique(out, p);
     // Plus the vertices of the clipped surface's convex hull: every point extreme in some
     // direction, not only in the 386 of the grid. Near a floor's normal the grid's directions
     // picked the rim of each of spot's hooves, 4 mm above its lowest point (a nearly flat sole
     // tilted by less than the grid's 4.5 degrees), and an interrupted answer missed a front foot
     // 0.3 mm into the floor: spot toppled at 60 Hz (docs/contact-tree.md, "Support points").
     if (detail::convexHullVertices(clipped, kMaxCellHullVertices, hull))
-      for (std::uint32_t id : hull) {
-        bool repeat = false;
-        for (const Vec3& q : out) repeat = repeat || q == clipped[id];
-        if (!repeat) out.push_back(clipped[id]);
-      }
+      for (std::uint32_t id : hull) appendUnique(out, clipped[id]);
     if (cell.depth >= maxDepth || tree.isLeaf(cell.node)) return;
     for (std::uint32_t octant = 0; octant < 8; ++octant) visit(tree.childCell(cell, octant), inside);
   }

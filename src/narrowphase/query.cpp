@@ -718,16 +718,6 @@ PatchAxis leastOverlapNormal(const PatchSide& sideA, const PatchSide& sideB, con
   return apart ? PatchAxis::kApart : PatchAxis::kChosen;
 }
 
-// Depth and point of a contact along a chosen normal n (A frame, B -> A) between two sides of
-// which at least one is faceted: the sides overlap along n over [min_A(n), max_B(n)]; depth =
-// max_B(n) - min_A(n), capped by the spheres' D&O depth (both bound the same thing from above;
-// a sphere side overestimates its surface); the point is the D&O point moved along n onto the
-// middle of that overlap (from a curved side's centre instead, see below) and, across n, clamped
-// into the common extent of the two sides along
-// two tangents (so it lies where both patches are, not beside the smaller one). For a box
-// resting on a box or a floor this is the true penetration and a point in the contact face at
-// every level, where the D&O point lies up to a sphere radius inside the upper box and its depth
-// is the spheres' overlap. Returns false when the sides are apart along n.
 // The vertex among `ids` of a side's mesh that reaches farthest along `dir` (A frame), in A's frame.
 Vec3 extremeVertex(const PatchSide& side, std::span<const std::uint32_t> ids, const Vec3& dir) {
   Vec3 best = Vec3::Zero();
@@ -739,6 +729,16 @@ Vec3 extremeVertex(const PatchSide& side, std::span<const std::uint32_t> ids, co
   return best;
 }
 
+// Depth and point of a contact along a chosen normal n (A frame, B -> A) between two sides of
+// which at least one is faceted: the sides overlap along n over [min_A(n), max_B(n)]; depth =
+// max_B(n) - min_A(n), capped by the spheres' D&O depth (both bound the same thing from above;
+// a sphere side overestimates its surface); the point is the D&O point moved along n onto the
+// middle of that overlap (from a curved side's centre instead, see below) and, across n, clamped
+// into the common extent of the two sides along
+// two tangents (so it lies where both patches are, not beside the smaller one). For a box
+// resting on a box or a floor this is the true penetration and a point in the contact face at
+// every level, where the D&O point lies up to a sphere radius inside the upper box and its depth
+// is the spheres' overlap. Returns false when the sides are apart along n.
 bool patchDepthAndPoint(const PatchSide& sideA, const PatchSide& sideB, const Vec3& n, Contact& c) {
   const double maxB = sideB.support(n);
   const double minA = -sideA.support(-n);
