@@ -689,5 +689,36 @@ TEST(CoarseContacts, ContactTreeSeesTheDeepestPointOfACurvedMeshAtEveryBudget) {
   }
 }
 
+// A curved mesh hovering just above a slab: an interrupted contact-tree answer must not report
+// it touching. Oracle: the mesh's vertices -- the gap between a mesh and a plane below it is its
+// lowest vertex's height. A lattice point that the slide along S's surface accepted up to its
+// projection tolerance off that surface (4.4 mm outside spot's hind feet, S's field bounding its
+// own error there by 2.5 mm) lay on the slab's top: zero-depth contacts on two feet at 62 and
+// 128 tests, 3 mm before the feet arrived. In the world spot stopped on them at 60 Hz, turned
+// about them and toppled at 2,048-8,192 tests per frame. The gap here (2 mm, 2.7 eps_s) is the
+// one spot had there; every contact fails (before the fix: 2-3 at 62 and 128 tests).
+TEST(CoarseContacts, ContactTreeGivesNoContactToACurvedMeshHoveringAboveASlab) {
+  constexpr double kDiagonal = 0.75, kGapRel = 0.0027;
+  const SlabBodies& b = slabBodies();
+  TriangleMesh mesh = loadMesh(std::string(CLOD_SHARED_MESH_DIR) + "/spot.obj").mesh;
+  const double scale = kDiagonal / mesh.bounds().diagonal();
+  for (Vec3& v : mesh.vertices) v *= scale;
+  const CollisionBody body = bakeLikeTheWorldTest(mesh);
+  // Standing on its feet (spot is modelled y-up) as it was dropped, and tipped a few degrees.
+  for (double tiltDeg : {0.0, 3.0, -3.0}) {
+    Pose pose;
+    pose.rotation = Quat(Eigen::AngleAxisd(tiltDeg * kDegree, Vec3::UnitY())) * Quat(Eigen::AngleAxisd(0.5 * kPi, Vec3::UnitX()));
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const Vec3& v : mesh.vertices) lowest = std::min(lowest, (pose.rotation * v).z());
+    pose.translation = Vec3(0.0, 0.055, kSlabTop - lowest + kGapRel * kDiagonal);
+    for (std::uint64_t budget : {std::uint64_t(1), std::uint64_t(16), std::uint64_t(62), std::uint64_t(128),
+                                 std::uint64_t(256), std::uint64_t(1024), kUnlimitedTests}) {
+      const QueryResult r = queryContacts(b.slab, Pose{}, body, pose, settingsFor(ContactModel::kContactTree, budget));
+      const std::string what = "tilt " + std::to_string(tiltDeg) + " at " + std::to_string(budget) + " tests";
+      for (const Contact& c : r.contacts) ADD_FAILURE() << what << ": contact at " << c.point.transpose() << " depth " << c.depth;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace clod
