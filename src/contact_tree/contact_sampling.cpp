@@ -133,7 +133,7 @@ double distanceAtSurface(const ContactFieldSample& f, const SurfacePoint& s, con
 // the margin and S's error target eps_s: O's distance corrected to S's surface
 // (distanceAtSurface) exceeds both fields' error bounds there by that much. A point that the
 // projection accepted off S's surface (within its tolerance, outside S) can lie on or inside O
-// while S itself stays clear of O: spot, 3 mm above the floor, got zero-depth contacts on its
+// while S itself stays clear of O: spot, 2 mm above the floor, got zero-depth contacts on its
 // hind feet 4.4 mm outside them at 62 tests per query, stopped there on two feet and toppled.
 // (Gaps below eps_s are not resolved by the fields; rejecting those too cost a landing bunny the
 // contacts on one side of its base, and it tipped over.)
