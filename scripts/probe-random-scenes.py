@@ -3,7 +3,7 @@
 the issue's numbers (docs/benchmarks/degradation.md, "Random drops").
 
 usage: scripts/probe-random-scenes.py SEED KINDS OUTDIR
-  KINDS: comma-separated of stack, pyramid, slide, slope-rest, slope-slide, drop
+  KINDS: comma-separated of stack, tower, pyramid, slide, slope-rest, slope-slide, drop
   environment: MODELS (cfm,contact-tree,exact), BUDGETS tests per frame (16,64,256,1024,0),
   BUS microseconds per frame (50,200,1000), RATES (240,60), J parallel runs (2),
   CLOD (build/bin/clod), CLOD_MESH_DIR (../shared/data/meshes).
@@ -62,18 +62,40 @@ def gen(kind, rng):
             for i in range(c):
                 bodies.append(boxb(f"box{r}{i}", [h,h,h], [(i-0.5*(c-1))*pitch, 0, h*(2*r+1)], mu))
         return {"duration":10.0,"bodies":bodies}, dict(kind='stack', move=0.05, tiltlim=2.0, speed=0.05)
+    if kind == 'tower':
+        # Boxes of different sizes and densities (each no larger than the one below), turned.
+        n = rng.randint(2, 5); mu = rng.uniform(0.4, 0.9); z = 0.0; bodies = []; last = None
+        for k in range(n):
+            h = [rng.uniform(0.15, 0.5), rng.uniform(0.15, 0.5), rng.uniform(0.08, 0.4)]
+            if last: h = [min(h[0], last[0]), min(h[1], last[1]), h[2]]
+            bodies.append(boxb(f"box{k}", h, [0, 0, z + h[2]], mu, qz(rng.uniform(0, 90)),
+                               extra={"density": rng.choice([100, 1000, 5000])}))
+            z += 2 * h[2]; last = h
+        bodies.insert(0, ground(3, 3, mu))
+        return {"duration":10.0,"bodies":bodies}, dict(kind='stack', move=0.02, tiltlim=1.0, speed=0.05)
     if kind == 'slide':
-        h = [rng.uniform(0.2,0.6), rng.uniform(0.2,0.6), rng.uniform(0.15,0.5)]
-        mu = rng.uniform(0.2, 0.6); v = rng.uniform(1.0, 3.0); ang = rng.uniform(0, 360)
+        # Sliding friction tips the box unless its line of action stays inside the base: mu times
+        # the height below the centre of mass under 80 % of the base's reach along the velocity.
+        while True:
+            h = [rng.uniform(0.2,0.6), rng.uniform(0.2,0.6), rng.uniform(0.15,0.5)]
+            mu = rng.uniform(0.2, 0.6); v = rng.uniform(1.0, 3.0); ang = rng.uniform(0, 360); yaw = rng.uniform(0, 90)
+            phi = math.radians(ang - yaw)
+            reach = min(h[0] / max(1e-9, abs(math.cos(phi))), h[1] / max(1e-9, abs(math.sin(phi))))
+            if mu * h[2] < 0.8 * reach: break
         d = v*v/(2*mu*G)
         dirv = [math.cos(math.radians(ang)), math.sin(math.radians(ang)), 0]
         L = d + 3
-        bodies = [ground(L, L, mu), boxb("box", h, [-dirv[0]*d/2, -dirv[1]*d/2, h[2]], mu, qz(rng.uniform(0,90)), [v*dirv[0], v*dirv[1], 0])]
+        bodies = [ground(L, L, mu), boxb("box", h, [-dirv[0]*d/2, -dirv[1]*d/2, h[2]], mu, qz(yaw), [v*dirv[0], v*dirv[1], 0])]
         return {"duration": v/(mu*G)+1.5, "bodies":bodies}, dict(kind='slide', dist=d, tiltlim=2.0)
     if kind in ('slope-rest', 'slope-slide'):
-        mu = rng.uniform(0.3, 0.8); fa = math.degrees(math.atan(mu))
-        th = rng.uniform(8, fa-5) if kind == 'slope-rest' else rng.uniform(fa+6, min(fa+25, 60))
-        h = [rng.uniform(0.2,0.5)]*2 + [rng.uniform(0.15,0.5)]
+        # Neither resting nor sliding may tip the box: tan(theta) at rest, mu when sliding, under
+        # 80 % of its half length over its half height.
+        while True:
+            mu = rng.uniform(0.3, 0.8); fa = math.degrees(math.atan(mu))
+            th = rng.uniform(8, fa-5) if kind == 'slope-rest' else rng.uniform(fa+6, min(fa+25, 60))
+            h = [rng.uniform(0.2,0.5)]*2 + [rng.uniform(0.15,0.5)]
+            lever = math.tan(math.radians(th)) if kind == 'slope-rest' else mu
+            if lever * h[2] < 0.8 * h[0]: break
         q = qy(th); n = rot(q,[0,0,1]); down = rot(q,[1,0,0])
         T = 4.0 if kind=='slope-rest' else 2.0
         a = G*(math.sin(math.radians(th)) - mu*math.cos(math.radians(th)))

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <initializer_list>
 #include <limits>
 #include <map>
 
@@ -89,6 +90,13 @@ struct Body {
   }
 };
 
+// The inverse effective mass of a contact in its tangent plane, in the basis (t1, t2): the
+// tangential velocity change per unit tangential impulse, K = [k11 k12; k12 k22]. The two
+// tangents are coupled through the bodies' rotation (k12 != 0 off the principal axes).
+struct TangentInverseMass {
+  double k11 = 0, k12 = 0, k22 = 0;
+};
+
 // One contact constraint; accumulated impulses persist for warm starting. The contact is
 // anchored in both bodies (anchorA, anchorB: body-frame offsets from the centre of mass), so its
 // separation follows the bodies' motion point by point (see persistContacts below).
@@ -98,9 +106,11 @@ struct SolverContact {
   double separation = 0;  // (anchor A - anchor B) . normal in the world: < 0 penetrating
   double speculative = 0; // max(separation, 0) / h: approach speed the velocity solve allows
   Vec3 rA = Vec3::Zero(), rB = Vec3::Zero(), t1 = Vec3::UnitX(), t2 = Vec3::UnitY();
-  double massN = 0, massT1 = 0, massT2 = 0;
+  double massN = 0;
+  TangentInverseMass tangentK;  // the tangent plane's 2 x 2 inverse effective mass (t1, t2)
   // The same with the lower body of a shock-propagation pair held fixed (orderSupportLayers).
-  double shockMassN = 0, shockMassT1 = 0, shockMassT2 = 0;
+  double shockMassN = 0;
+  TangentInverseMass shockTangentK;
   double restitution = 0; // coefficient if this contact bounces this substep, else 0
   double targetPos = 0;   // pseudo-velocity target (split impulse)
   double lambdaN = 0, lambdaT1 = 0, lambdaT2 = 0, lambdaP = 0;
@@ -125,16 +135,23 @@ struct PairState {
 
 std::uint64_t pairKey(BodyId a, BodyId b) { return (std::uint64_t(a) << 32) | b; }
 
-// One friction update of a contact: the tangential impulse that stops the sliding velocity
-// (massT1 * v.t1, massT2 * v.t2 along the two tangents, already scaled by the effective masses)
-// added to the accumulated one, and the sum clamped to the Coulomb cone |lambdaT| <= limit
-// (mu times the normal impulse). Clamping each tangent on its own (a friction pyramid) lets a
-// body sliding diagonally to the tangents feel up to sqrt 2 times mu N, its friction pointing
-// along the diagonal instead of against the velocity: a box sliding at 48 deg to the world axes
-// turned toward an axis, stopped short and tipped over. Returns the impulse change (world).
-Vec3 frictionStep(SolverContact& cp, double stop1, double stop2, double limit) {
+// One friction update of a contact: an impulse against the sliding velocity (v1, v2 along t1,
+// t2) that stops its component along that velocity -- its size 1 / (d^T K d) per unit speed, d
+// the sliding direction, K the tangent inverse mass -- added to the accumulated tangential
+// impulse, and the sum clamped to the Coulomb cone |lambdaT| <= limit (mu times the normal
+// impulse). Why the step is along the velocity: a sliding contact's accumulated impulse settles
+// where the step is parallel to it, so it ends parallel to the sliding velocity -- Coulomb's
+// maximal dissipation. A step scaled per tangent (mass_t1 v1, mass_t2 v2) settles parallel to
+// that scaled velocity instead, and a box whose corners have different tangent masses (any box
+// sliding off the world axes) was pushed sideways and spun: it slid 7 % too far and turned 5 deg
+// off its heading. Clamping each tangent on its own (a friction pyramid) is worse still: up to
+// sqrt 2 times mu N, along the diagonal. Returns the impulse change (world).
+Vec3 frictionStep(SolverContact& cp, double v1, double v2, const TangentInverseMass& k, double limit) {
   const double old1 = cp.lambdaT1, old2 = cp.lambdaT2;
-  double l1 = old1 - stop1, l2 = old2 - stop2;
+  const double speedSq = v1 * v1 + v2 * v2;
+  const double kAlong = speedSq > 0.0 ? (v1 * (k.k11 * v1 + k.k12 * v2) + v2 * (k.k12 * v1 + k.k22 * v2)) / speedSq : 0.0;
+  if (!(kAlong > 0.0)) return Vec3::Zero();  // no sliding, or nothing that can move
+  double l1 = old1 - v1 / kAlong, l2 = old2 - v2 / kAlong;
   const double length = std::hypot(l1, l2);
   if (length > limit) {
     const double scale = limit > 0.0 ? limit / length : 0.0;
@@ -151,6 +168,24 @@ void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
   const Vec3 a = std::abs(n.x()) < 0.57735 ? Vec3::UnitX() : (std::abs(n.y()) < 0.57735 ? Vec3::UnitY() : Vec3::UnitZ());
   t1 = n.cross(a).normalized();
   t2 = n.cross(t1);
+}
+
+// K in the tangent plane (t1, t2) for the given total inverse mass and lever arms r with their
+// bodies' world inverse inertia: k_ij = invMass t_i . t_j + sum (r x t_i) . I^-1 (r x t_j).
+struct LeverArm {
+  Vec3 r;
+  const Mat3* invInertia;
+};
+TangentInverseMass tangentInverseMass(double invMass, const Vec3& t1, const Vec3& t2, std::initializer_list<LeverArm> arms) {
+  TangentInverseMass k{invMass, 0.0, invMass};
+  for (const LeverArm& arm : arms) {
+    const Vec3 r1 = arm.r.cross(t1), r2 = arm.r.cross(t2);
+    const Vec3 i1 = *arm.invInertia * r1, i2 = *arm.invInertia * r2;
+    k.k11 += r1.dot(i1);
+    k.k12 += r1.dot(i2);
+    k.k22 += r2.dot(i2);
+  }
+  return k;
 }
 
 // Outward unit direction of body `fixed`'s oriented bounding box (its mesh bounds, turned and
@@ -600,8 +635,8 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
         return k > 0.0 ? 1.0 / k : 0.0;
       };
       cp.massN = effMass(n);
-      cp.massT1 = effMass(cp.t1);
-      cp.massT2 = effMass(cp.t2);
+      cp.tangentK = tangentInverseMass(a.invMass + b.invMass, cp.t1, cp.t2,
+                                       {{cp.rA, &a.invInertiaWorld}, {cp.rB, &b.invInertiaWorld}});
       const Vec3 vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
       const double vn = vr.dot(n);
       // Restitution by Poisson's hypothesis, applied after the velocity iterations: the solver
@@ -882,7 +917,7 @@ void World::Impl::solve(double h) {
         upper.w += sign * (upper.invInertiaWorld * r.cross(impulse));
       };
       const Vec3 vt = relative();
-      push(frictionStep(cp, cp.shockMassT1 * vt.dot(cp.t1), cp.shockMassT2 * vt.dot(cp.t2), mu * cp.lambdaN));
+      push(frictionStep(cp, vt.dot(cp.t1), vt.dot(cp.t2), cp.shockTangentK, mu * cp.lambdaN));
       double old = cp.lambdaN;
       cp.lambdaN = std::max(0.0, old - cp.shockMassN * (relative().dot(cp.c.normal) + cp.speculative));
       push((cp.lambdaN - old) * cp.c.normal);
@@ -921,7 +956,7 @@ void World::Impl::solve(double h) {
         const Vec3 vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
         const Vec3 vt = vr - vr.dot(cp.c.normal) * cp.c.normal;
         if (vt.squaredNorm() <= slipping * slipping) continue;
-        apply(a, b, cp, frictionStep(cp, cp.massT1 * vr.dot(cp.t1), cp.massT2 * vr.dot(cp.t2), mu * cp.lambdaN));
+        apply(a, b, cp, frictionStep(cp, vr.dot(cp.t1), vr.dot(cp.t2), cp.tangentK, mu * cp.lambdaN));
       }
     }
   };
@@ -942,7 +977,7 @@ void World::Impl::solve(double h) {
           // Friction first, limited by the current normal impulse; then the normal, so that
           // non-penetration, the more important constraint, is solved last (Catto 2005).
           Vec3 vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
-          const Vec3 friction = frictionStep(cp, cp.massT1 * vr.dot(cp.t1), cp.massT2 * vr.dot(cp.t2), mu * cp.lambdaN);
+          const Vec3 friction = frictionStep(cp, vr.dot(cp.t1), vr.dot(cp.t2), cp.tangentK, mu * cp.lambdaN);
           apply(a, b, cp, friction);
           maxChange = std::max(maxChange, friction.norm());
           vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
@@ -1130,8 +1165,7 @@ void World::Impl::orderSupportLayers() {
         return kUpper > 0.0 ? 1.0 / kUpper : 0.0;
       };
       cp.shockMassN = massAlong(cp.c.normal);
-      cp.shockMassT1 = massAlong(cp.t1);
-      cp.shockMassT2 = massAlong(cp.t2);
+      cp.shockTangentK = tangentInverseMass(upper.invMass, cp.t1, cp.t2, {{r, &upper.invInertiaWorld}});
     }
   }
 }
