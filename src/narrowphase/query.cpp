@@ -1734,10 +1734,17 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
   bool finished = false;
   bool exactInterrupted = false;
 
-  if (model == ContactModel::kExact && a.patchIsWholeConvexBody(0) && b.patchIsWholeConvexBody(0)) {
+  const bool surfaceModel = model == ContactModel::kExact || model == ContactModel::kContactTree;
+  if (surfaceModel && a.patchIsWholeConvexBody(0) && b.patchIsWholeConvexBody(0)) {
     // Two convex polyhedra: the separating-axis test over their face normals and edge-edge axes
     // gives the exact penetration depth and normal, and clipping the facing faces the exact
-    // contact polygon -- the triangle-level answer, in one test (convexPolyhedraContacts).
+    // contact polygon -- the triangle-level answer, in one test (convexPolyhedraContacts). The
+    // contact tree answers such a pair the same way: the root cell of a convex polyhedron keeps
+    // the body's corners as its support points (its hull is the body), so its coarsest answer
+    // already knows the whole surface, where sampling its fields at a coarse frontier found a
+    // part of a face-on-face overlap (a twisted box on a box rested on three contacts on one
+    // side and tipped 8-11 deg at 16 tests per frame; a box sliding down a slope tipped over at
+    // 256 tests). cfm's root patches of convex polyhedra answer the same way (sphereContacts).
     convexPolyhedraContacts(a, b, xfAFromB, s.raw);
     meter.take();
     finished = true;

@@ -677,9 +677,10 @@ TEST(World, BudgetCountsFrontierPairs) {
     World world(ws);
     addStaticGround(world, slab);
     for (int i = 0; i < 8; ++i) {
-      // cfm answers a 12-triangle cube's pairs at the root (its patch is the whole convex body,
-      // nothing to refine): a cube with 3 x 3 squares per face has frontiers to grow.
-      RigidBodyDesc box = dynamicBox(model == ContactModel::kCfm ? gridCube : unitCube(), Vec3(0.5, 0.5, 0.5), 1.0);
+      // cfm and the contact tree answer a 12-triangle cube's pairs with a slab at the root (both
+      // are whole convex polyhedra, nothing to refine): a cube with 3 x 3 squares per face has
+      // frontiers to grow.
+      RigidBodyDesc box = dynamicBox(gridCube, Vec3(0.5, 0.5, 0.5), 1.0);
       box.position = Vec3(-1.65 + 1.1 * (i % 4), i < 4 ? -0.55 : 0.55, 0.8 + 0.05 * i);
       world.addBody(box);
     }
