@@ -1735,7 +1735,8 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
   bool exactInterrupted = false;
 
   const bool surfaceModel = model == ContactModel::kExact || model == ContactModel::kContactTree;
-  if (surfaceModel && a.patchIsWholeConvexBody(0) && b.patchIsWholeConvexBody(0)) {
+  const bool convexPair = surfaceModel && a.patchIsWholeConvexBody(0) && b.patchIsWholeConvexBody(0);
+  if (convexPair) {
     // Two convex polyhedra: the separating-axis test over their face normals and edge-edge axes
     // gives the exact penetration depth and normal, and clipping the facing faces the exact
     // contact polygon -- the triangle-level answer, in one test (convexPolyhedraContacts). The
@@ -1898,7 +1899,7 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
   // answer deadline.
   const bool answerTimeLeft = !(settings.budget.deadline != QueryBudget::TimePoint::max() &&
                                 settings.budget.answerWithinDeadline && settings.budget.now() >= settings.budget.deadline);
-  if (cells && !found && kept >= 2 && answerTimeLeft) {
+  if (cells && !convexPair && !found && kept >= 2 && answerTimeLeft) {
     extendContactsToRim(a.contactTree(), xfWorldFromA, b.contactTree(), xfWorldFromB, result.contacts,
                         settings.contactSampling.marginAbs);
   }
