@@ -862,11 +862,6 @@ TEST(World, DosPileInAStaticBinStaysInAndGainsNoEnergy) {
 TEST(World, TumbledPileInAWideBinStaysInWithEverySurfaceModel) {
   const double halfWidth = 2.2, halfSize = 0.15;
   for (ContactModel model : {ContactModel::kCfm, ContactModel::kContactTree, ContactModel::kExact}) {
-    // Under the sanitizers the pile is one layer (dropPileIntoBin) and the landings differ in the
-    // last bits: the contact tree's deepest landing there is 3.8 cm (0.1116 m), against 3.6 cm
-    // (0.114 m) in Release, both at the edge of the 3.75 cm allowance (docs/dynamics.md, "Known
-    // limits"). Its bound is asserted in Release; the sanitizer run keeps cfm and exact.
-    if (sanitizerRun() && model == ContactModel::kContactTree) continue;
     const PileOutcome pile = dropPileIntoBin(model, 80, halfWidth, 2);
     const std::string what(contactModelName(model));
     EXPECT_EQ(pile.leftBounds, 0u) << what;
