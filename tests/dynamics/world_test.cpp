@@ -860,8 +860,12 @@ TEST(World, DosPileInAStaticBinStaysInAndGainsNoEnergy) {
 // quarter of that (the bodies land at up to 3.4 m/s on answers from the top levels of the
 // trees), never through.
 TEST(World, TumbledPileInAWideBinStaysInWithEverySurfaceModel) {
+  // Under the sanitizers one layer (dropPileIntoBin) with the contact tree alone: it runs both
+  // the separating-axis answer (boxes) and the fields (balls); cfm's and exact's paths run in the
+  // other world tests there. Release drops two layers with every model.
   const double halfWidth = 2.2, halfSize = 0.15;
   for (ContactModel model : {ContactModel::kCfm, ContactModel::kContactTree, ContactModel::kExact}) {
+    if (sanitizerRun() && model != ContactModel::kContactTree) continue;
     const PileOutcome pile = dropPileIntoBin(model, 80, halfWidth, 2);
     const std::string what(contactModelName(model));
     EXPECT_EQ(pile.leftBounds, 0u) << what;

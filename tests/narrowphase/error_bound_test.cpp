@@ -105,7 +105,10 @@ struct Tally {
 };
 
 TEST(ErrorBound, DepthWithinItsBoundOfThePenetrationAlongTheNormal) {
-  const int poses = std::getenv("CLOD_ERROR_BOUND_POSES") ? std::atoi(std::getenv("CLOD_ERROR_BOUND_POSES")) : 25;
+  // Under the sanitizers 6 poses per pair run every model's code path; the rates below are
+  // statistics of 25 and more, asserted in Release only (tests/support/test_scale.h).
+  const int poses = std::getenv("CLOD_ERROR_BOUND_POSES") ? std::atoi(std::getenv("CLOD_ERROR_BOUND_POSES"))
+                                                          : (test::sanitizerRun() ? 6 : 25);
   std::vector<Shape> shapes;
   shapes.push_back(makeShape("box", makeBox(Vec3::Constant(0.5))));
   shapes.push_back(makeShape("sphere", makeIcosphere(0.5, 2)));
@@ -183,6 +186,7 @@ TEST(ErrorBound, DepthWithinItsBoundOfThePenetrationAlongTheNormal) {
   auto expectRate = [&](const std::string& key, double rate) {
     const Tally& t = tallies[key];
     EXPECT_GT(t.contacts, 0u) << key;
+    if (test::sanitizerRun()) return;
     EXPECT_GE(double(t.held), rate * double(t.contacts)) << key << ": worst excess " << t.worstExcess << " of the diagonal";
   };
   for (const char* model : {"cfm", "exact"}) {
