@@ -282,7 +282,7 @@ const char* bodyTypeName(BodyType type) {
 std::unique_ptr<PyWorld> makeWorld(const ArrayLike& gravity, const std::string& model, std::uint64_t budget, double budgetUs, double dt,
                                    std::uint32_t maxContacts, std::uint32_t minSubsteps, std::uint32_t maxSubsteps,
                                    std::uint32_t velocityIterations, std::uint32_t positionIterations, std::uint32_t frontierPairCost,
-                                   double restitutionThreshold) {
+                                   double restitutionThreshold, double rollingResistance) {
   WorldSettings s;
   s.gravity = vec3Arg(gravity, "gravity");
   s.model = parseContactModel(model);
@@ -295,6 +295,7 @@ std::unique_ptr<PyWorld> makeWorld(const ArrayLike& gravity, const std::string& 
   s.positionIterations = positionIterations;
   s.frontierPairCost = frontierPairCost;
   s.restitutionThreshold = restitutionThreshold;
+  s.rollingResistanceRel = rollingResistance;
   if (!std::isfinite(dt) || !(dt > 0.0)) invalidArgument("dt: must be finite and > 0");
   auto w = std::make_unique<PyWorld>(World(s));
   w->dt = dt;
@@ -863,6 +864,7 @@ void bindDynamics(py::module_& mod) {
            py::arg("min_substeps") = w.minSubsteps, py::arg("max_substeps") = w.maxSubsteps,
            py::arg("velocity_iterations") = w.velocityIterations, py::arg("position_iterations") = w.positionIterations,
            py::arg("frontier_pair_cost") = w.frontierPairCost, py::arg("restitution_threshold") = w.restitutionThreshold,
+           py::arg("rolling_resistance") = w.rollingResistanceRel,
            "An empty world. budget: tests per step (0 = unlimited); budget_us: narrow-phase microseconds per step\n"
            "(0 = none; not repeatable bit for bit); dt: the default step length of step() and run().\n"
            "Out-of-range settings raise clod.InvalidArgumentError naming the setting.")

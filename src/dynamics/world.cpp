@@ -120,6 +120,11 @@ struct SolverContact {
 
 struct PairState {
   CoherenceCache cache;
+  // Rolling resistance (solve): the accumulated angular impulse about the tangent axes u1, u2 of
+  // the pair's mean contact normal, and the 2 x 2 inverse angular mass about them.
+  double rollingL1 = 0, rollingL2 = 0;
+  Vec3 rollingU1 = Vec3::UnitX(), rollingU2 = Vec3::UnitY();
+  TangentInverseMass rollingK;
   std::vector<SolverContact> contacts;
   std::vector<SolverContact> previous;
   std::uint32_t stale = 0;   // substeps since last query
@@ -230,6 +235,8 @@ struct World::Impl {
     if (s.velocityIterations == 0) bad("velocityIterations must be >= 1");
     if (!(s.correctionFactor > 0.0 && s.correctionFactor <= 1.0)) bad("correctionFactor must be in (0, 1]");
     if (!(s.slopRel >= 0.0 && std::isfinite(s.slopRel))) bad("slopRel must be >= 0 and finite");
+    if (!(s.rollingResistanceRel >= 0.0 && std::isfinite(s.rollingResistanceRel)))
+      bad("rollingResistanceRel must be >= 0 and finite");
     if (!(s.reuseMotionRel >= 0.0 && s.reuseMotionRel < 1.0)) bad("reuseMotionRel must be in [0, 1)");
     if (!(s.restitutionThreshold >= 0.0 && std::isfinite(s.restitutionThreshold))) bad("restitutionThreshold must be >= 0");
     if (!(s.convergenceRel >= 0.0)) bad("convergenceRel must be >= 0");
@@ -960,6 +967,48 @@ void World::Impl::solve(double h) {
       }
     }
   };
+  // Rolling resistance (WorldSettings::rollingResistanceRel): the bodies' relative turn about
+  // the pair's tangent axes (those of its mean contact normal) is resisted by an angular impulse
+  // of at most rollingResistanceRel x the smaller diagonal x the pair's normal impulse, stepped
+  // along the turn as friction is (frictionStep) and not warm-started (its limit follows the
+  // normal impulses of the same sweep).
+  const double rollingRel = s.rollingResistanceRel;
+  auto rollingStep = [&](PairState& p, Body& a, Body& b) {
+    double lambdaN = 0.0;
+    for (const SolverContact& cp : p.contacts) lambdaN += cp.lambdaN;
+    const double limit = rollingRel * std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal()) * lambdaN;
+    const Vec3 w = a.w - b.w;
+    const double w1 = w.dot(p.rollingU1), w2 = w.dot(p.rollingU2);
+    const TangentInverseMass& k = p.rollingK;
+    const double speedSq = w1 * w1 + w2 * w2;
+    const double kAlong = speedSq > 0.0 ? (w1 * (k.k11 * w1 + k.k12 * w2) + w2 * (k.k12 * w1 + k.k22 * w2)) / speedSq : 0.0;
+    if (!(kAlong > 0.0)) return;
+    const double old1 = p.rollingL1, old2 = p.rollingL2;
+    double l1 = old1 - w1 / kAlong, l2 = old2 - w2 / kAlong;
+    const double length = std::hypot(l1, l2);
+    if (length > limit) {
+      const double scale = limit > 0.0 ? limit / length : 0.0;
+      l1 *= scale;
+      l2 *= scale;
+    }
+    p.rollingL1 = l1;
+    p.rollingL2 = l2;
+    const Vec3 impulse = (l1 - old1) * p.rollingU1 + (l2 - old2) * p.rollingU2;
+    a.w += a.invInertiaWorld * impulse;
+    b.w -= b.invInertiaWorld * impulse;
+  };
+  if (rollingRel > 0.0)
+    for (auto& [p, ids] : solveOrder) {
+      p->rollingL1 = p->rollingL2 = 0.0;
+      if (p->contacts.empty()) continue;
+      Vec3 n = Vec3::Zero();
+      for (const SolverContact& cp : p->contacts) n += cp.c.normal;
+      if (n.squaredNorm() == 0.0) n = p->contacts.front().c.normal;
+      n.normalize();
+      tangents(n, p->rollingU1, p->rollingU2);
+      const Mat3 kw = bodies[ids[0]].invInertiaWorld + bodies[ids[1]].invInertiaWorld;
+      p->rollingK = {p->rollingU1.dot(kw * p->rollingU1), p->rollingU1.dot(kw * p->rollingU2), p->rollingU2.dot(kw * p->rollingU2)};
+    }
   auto iterate = [&](bool warm) {
     if (warm)
       for (auto& [p, ids] : solveOrder)
@@ -987,6 +1036,7 @@ void World::Impl::solve(double h) {
           maxChange = std::max(maxChange, std::abs(cp.lambdaN - old));
           maxLambda = std::max(maxLambda, cp.lambdaN);
         }
+        if (rollingRel > 0.0 && !p->contacts.empty()) rollingStep(*p, a, b);
       }
       if (s.convergenceRel > 0.0 && maxChange <= s.convergenceRel * maxLambda) break;
     }

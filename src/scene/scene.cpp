@@ -202,7 +202,7 @@ SceneDescription parseScene(std::string_view text, const std::filesystem::path& 
     throw Error(ErrorCode::kSceneError, fileName + ": not valid JSON: " + e.what());
   }
   r.object(j, "", {"gravity", "dt", "steps", "duration", "contact_model", "budget", "budget_us", "max_contacts", "min_substeps",
-                  "min_substep_iterations", "frontier_pair_cost", "bounds", "bodies"});
+                  "min_substep_iterations", "frontier_pair_cost", "rolling_resistance", "bounds", "bodies"});
   SceneDescription s;
   if (j.contains("gravity")) s.world.gravity = r.vec<3>(j["gravity"], "gravity");
   if (j.contains("dt")) s.dt = r.positive(j["dt"], "dt");
@@ -233,6 +233,10 @@ SceneDescription parseScene(std::string_view text, const std::filesystem::path& 
   if (j.contains("min_substep_iterations"))
     s.world.minSubstepIterations =
         std::uint32_t(r.count(j["min_substep_iterations"], "min_substep_iterations", 0, s.world.velocityIterations));
+  if (j.contains("rolling_resistance")) {
+    s.world.rollingResistanceRel = r.nonNegative(j["rolling_resistance"], "rolling_resistance");
+    if (s.world.rollingResistanceRel > 1.0) r.fail("rolling_resistance", "must be at most 1 (a fraction of the smaller body's diagonal)");
+  }
   if (j.contains("frontier_pair_cost"))
     s.world.frontierPairCost = std::uint32_t(r.count(j["frontier_pair_cost"], "frontier_pair_cost", 0, 1024));
   if (j.contains("bounds")) {

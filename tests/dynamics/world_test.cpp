@@ -216,6 +216,45 @@ TEST(World, BoxSlidingInAnyDirectionStopsAfterVSquaredOverTwoMuGInAStraightLine)
   }
 }
 
+// Rolling resistance (WorldSettings::rollingResistanceRel): a ball on a slope is held where the
+// resisting moment, c N with c = rollingResistanceRel x its diagonal, can balance the friction
+// that keeps it from sliding, m g sin(theta) r: tan(theta) <= c / r. Oracle: that statics, for
+// a ball of radius r = 0.15 (an icosphere of 1,280 faces; its bounding-box diagonal 2 sqrt(3) r)
+// at rollingResistanceRel 0.05, c / r = 0.173, 9.8 deg, with margins on both sides for the
+// facet it rests on (its three corners add a moment of their own: alone they hold it up to ~2.5
+// deg; together with the resistance measured up to 11 deg, rolling at 14). Measured over 2 s once
+// it has settled onto its lowest facet (0.5 s): at 6 deg it stays (< 5 mm: the solver's creep,
+// measured 0.4-0.8 mm), at 14 deg it rolls (> 10 cm; measured 1.2 m). Control: without rolling
+// resistance it rolls at 6 deg (measured 1.6 m).
+TEST(World, BallOnASlopeIsHeldByRollingResistanceBelowItsAngleAndRollsAbove) {
+  constexpr double kRadius = 0.15;
+  const auto slab = bakeShape(makeBox(Vec3(6.0, 1.5, 0.25)));
+  const auto ball = bakeShape(makeIcosphere(kRadius, 3));
+  auto travel = [&](ContactModel model, double slopeDeg, double rolling) {
+    const Quat slope(Eigen::AngleAxisd(slopeDeg * M_PI / 180.0, Vec3::UnitY()));
+    WorldSettings ws;
+    ws.model = model;
+    ws.rollingResistanceRel = rolling;
+    World world(ws);
+    addStaticGround(world, slab, "", 0.8, Pose{slope, Vec3::Zero()});
+    RigidBodyDesc d = dynamicBox(ball, Vec3::Constant(kRadius), 1.0);
+    d.inertia = Mat3::Identity() * (0.4 * kRadius * kRadius);  // solid ball, 2/5 m r^2
+    d.friction = 0.8;  // tan 14 deg = 0.25: it never slides
+    d.position = slope * Vec3(0.0, 0.0, 0.25 + kRadius);
+    const BodyId id = world.addBody(d);
+    for (int i = 0; i < 30; ++i) world.step(1.0 / 60.0);  // settles onto its lowest facet
+    const Vec3 settled = world.state(id).position;
+    for (int i = 0; i < 120; ++i) world.step(1.0 / 60.0);
+    return (world.state(id).position - settled).norm();
+  };
+  for (ContactModel model : {ContactModel::kCfm, ContactModel::kExact, ContactModel::kContactTree}) {
+    const std::string what(contactModelName(model));
+    EXPECT_LT(travel(model, 6.0, 0.05), 0.005) << what << ": held below the rolling resistance angle";
+    EXPECT_GT(travel(model, 14.0, 0.05), 0.1) << what << ": rolls above it";
+    EXPECT_GT(travel(model, 6.0, 0.0), 0.1) << what << ": without rolling resistance it rolls at 6 deg (the test's control)";
+  }
+}
+
 // A box sliding down a 35 deg slope (mu 0.3) covers a t^2 / 2, a = g (sin - mu cos), at 60 Hz too:
 // positions are integrated with the trapezoid rule along the directions no contact presses
 // (docs/dynamics.md, "Solver"). Semi-implicit Euler overshoots by a t h / 2, h the substep (here
