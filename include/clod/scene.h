@@ -10,7 +10,7 @@
 // "min_substeps" (WorldSettings::minSubsteps, default 1; tall stacks need ~8),
 // "min_substep_iterations" (WorldSettings::minSubstepIterations, 0..20, default 4),
 // "frontier_pair_cost" (WorldSettings::frontierPairCost, 0..1024, default 2),
-// "rolling_resistance" (WorldSettings::rollingResistanceRel, 0..1, default 0.005),
+// "rolling_resistance" (WorldSettings::rollingResistanceRel, 0..1, default 0.003),
 // "bounds" {"min": [..], "max": [..]}, "bodies" [ ... ]. Body keys: "name", exactly one of
 // "mesh" (path relative to the scene file), "box" [hx,hy,hz] (half extents) or "sphere" r;
 // "position", "orientation" [w,x,y,z], "velocity", "angular_velocity", "torque" [x,y,z] (N m,

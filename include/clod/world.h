@@ -180,9 +180,9 @@ struct WorldSettings {
   /// this length times the pair's normal impulse -- the moment of a contact's pressure shifted
   /// that far ahead of the rolling direction, as real (deforming) bodies shift it. A rigid curved
   /// body rolling without slip loses no energy, so without it a bunny landed on its round back
-  /// rocked for 5 s and more with every model (docs/dynamics.md, "Rolling resistance"); a body
-  /// tips over it at tan(slope) = this x diagonal / lever. 0 = none. Must be >= 0 and finite.
-  double rollingResistanceRel = 0.005;
+  /// rocked for 5 s and more with every model (docs/dynamics.md, "Rolling resistance", says why
+  /// 0.3 %); a body rolls beyond tan(slope) = this x diagonal / lever. 0 = none; >= 0, finite.
+  double rollingResistanceRel = 0.003;
   /// Split-impulse penetration correction: fraction of (depth - slop) removed per substep
   /// (Baumgarte-like factor, in (0, 1]) and the allowed penetration, relative to the smaller
   /// body's bounding-box diagonal.

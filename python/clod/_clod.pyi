@@ -303,7 +303,7 @@ class World:
         position_iterations: int = 4,
         frontier_pair_cost: int = 2,
         restitution_threshold: float = 0.5,
-        rolling_resistance: float = 0.005,
+        rolling_resistance: float = 0.003,
     ) -> None: ...
     @staticmethod
     def from_scene(path: str, *, model: Optional[str] = None, budget: Optional[int] = None,
