@@ -139,6 +139,14 @@ struct QueryResult {
   /// budget it is always 0: the exact model never falls back there.
   std::uint64_t fallbackPairs = 0;
   ContactModel fallbackModel = ContactModel::kExact;
+  /// A lower bound on the distance between the two bodies' surfaces, > 0 when the query proved
+  /// them apart everywhere: every pair of its traversal ended separated by its bounding spheres
+  /// (the surfaces lie inside them), so the smallest gap between two such spheres bounds the
+  /// surfaces' distance; no contact, not contained. 0 when some pair was not so separated (a
+  /// frontier pair that gave no contact proves nothing about the gap) or the query stopped early.
+  /// The world skips a pair while its bodies have moved against each other by less than this
+  /// (docs/dynamics.md, "Proven apart").
+  double separation = 0.0;
   /// Wall-clock seconds the query took.
   double seconds = 0.0;
 };
@@ -208,5 +216,17 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
 /// Convenience: one query with fresh scratch memory (allocates).
 QueryResult queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const CollisionBody& b,
                           const Pose& xfWorldFromB, const QuerySettings& settings);
+
+/// A lower bound on the distance between the two bodies' surfaces from their sphere-trees alone,
+/// or 0 when it cannot prove them apart within `maxTests` sphere tests: the traversal of
+/// queryContacts without contacts, > 0 only when every sphere pair ended separated (the smallest
+/// gap between two separated spheres; the spheres hold the surfaces) and neither body lies inside
+/// the other (closed bodies; a seed vertex against the other's field, as queryContacts checks
+/// containment). Costs at most maxTests sphere tests plus a few field queries; no allocation
+/// once the scratch has grown. `testsUsed`, if given, receives the tests made. The world asks
+/// it first for a pair without contacts that a time budget would answer from the roots
+/// (docs/dynamics.md, "Proven apart").
+double proveApart(const CollisionBody& a, const Pose& xfWorldFromA, const CollisionBody& b, const Pose& xfWorldFromB,
+                  std::uint64_t maxTests, QueryScratch& scratch, std::uint64_t* testsUsed = nullptr);
 
 }  // namespace clod

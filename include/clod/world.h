@@ -229,6 +229,9 @@ struct PairReport {
   /// against each other by less than WorldSettings::reuseMotionRel, so its manifold stands
   /// (docs/dynamics.md, "Manifold reuse").
   bool reused = false;
+  /// Not queried in the last substep: its last query proved the surfaces apart by a gap
+  /// (QueryResult::separation) that the bodies have not moved against each other since.
+  bool provenApart = false;
   /// Exact model: frontier pairs of the last query answered by the cfm (or dos) fallback instead
   /// of triangle tests (QueryResult::fallbackPairs); 0 at an unlimited budget.
   std::uint64_t fallbackPairs = 0;
@@ -260,6 +263,7 @@ struct StepReport {
   double timeSpentMicros = 0.0;
   std::uint64_t pairsSkipped = 0;    ///< pair queries skipped for lack of budget, summed
   std::uint64_t pairsReused = 0;     ///< pair queries saved by manifold reuse (PairReport::reused), summed
+  std::uint64_t pairsProvenApart = 0;  ///< pair queries saved by a proven gap (PairReport::provenApart), summed
   std::uint64_t pairsInterrupted = 0;///< queries that stopped before the leaves, summed
   /// Exact model: frontier pairs answered by the cfm / dos fallback, summed over pairs and
   /// substeps (PairReport::fallbackPairs); 0 for the other models and at an unlimited budget.

@@ -261,6 +261,8 @@ class StepReport:
     time_spent_micros: float
     pairs_skipped: int
     pairs_interrupted: int
+    pairs_reused: int
+    pairs_proven_apart: int
     fallback_pairs: int
     solver_iterations: int
     cold_restarts: int

@@ -761,6 +761,8 @@ void bindDynamics(py::module_& mod) {
       .def_readonly("time_spent_micros", &StepReport::timeSpentMicros, "narrow-phase time the time budget counted")
       .def_readonly("pairs_skipped", &StepReport::pairsSkipped, "pair queries skipped for lack of budget (old contacts kept)")
       .def_readonly("pairs_interrupted", &StepReport::pairsInterrupted, "queries that stopped before the leaves")
+      .def_readonly("pairs_reused", &StepReport::pairsReused, "pair queries saved by manifold reuse")
+      .def_readonly("pairs_proven_apart", &StepReport::pairsProvenApart, "pair queries saved by a gap the last query proved")
       .def_readonly("fallback_pairs", &StepReport::fallbackPairs, "exact model: frontier pairs answered by the cfm/dos fallback")
       .def_readonly("solver_iterations", &StepReport::solverIterations, "velocity iterations, summed over substeps")
       .def_readonly("cold_restarts", &StepReport::coldRestarts, "substeps whose warm-started solve was redone from zero")

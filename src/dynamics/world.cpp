@@ -37,6 +37,9 @@ constexpr double kAnchorDriftRel = 0.01;
 // substep, so a body arriving at speed is first found at most that deep inside the other (issue
 // 17 allows 1 % at any frame), in at most kMaxArrivalSubsteps substeps from this rule.
 constexpr double kArrivalTravelRel = 0.005;
+// Sphere tests a pair without contacts may spend proving itself apart (proveApart) before a time
+// budget answers it from the roots (World::Impl::substep).
+constexpr std::uint64_t kProofTests = 128;
 constexpr double kMaxArrivalSubsteps = 8.0;
 // ... and up to this many for the part of that travel that brings them together: all of it for
 // a pair without contacts, the motion along the contacts' normals and the turning for a pair in
@@ -64,6 +67,7 @@ struct Body {
   Vec3 comLocal = Vec3::Zero();
   Aabb localBox;         // mesh bounds, mesh coordinates
   double minExtent = 0;  // smallest side of localBox
+  double frameReach = 0; // farthest corner of localBox from the mesh origin (a turn's lever)
   // State: centre of mass in the world, orientation, velocities.
   Vec3 x = Vec3::Zero();
   Quat q = Quat::Identity();
@@ -134,6 +138,9 @@ struct PairState {
   bool interrupted = false;  // the last query stopped at its budget (QueryResult::finished false)
   bool keptFiner = false;    // the last query's coarser answer was dropped for the finer manifold
   bool reusable = false;     // the last query finished; `queriedAt` is B's pose in A's frame then
+  double apartBy = 0.0;      // the last query proved the surfaces this far apart (QueryResult::separation)
+  bool proofFailed = false;  // proveApart could not separate the pair at B's pose `proofFailedAt` in A
+  Pose proofFailedAt;
   std::uint64_t share = 0;   // the even share of the budget the last query had (limited budgets)
   Pose queriedAt;
 };
@@ -264,6 +271,8 @@ struct World::Impl {
   double arrivalTravel(const BodyPair& c, double dt) const;
   bool reuseManifold(const PairState& p, const Body& a, const Body& b) const;
   double motionSinceQuery(const PairState& p, const Body& a, const Body& b) const;
+  double reachSinceQuery(const PairState& p, const Body& a, const Body& b) const;
+  double reachSince(const Pose& bInAThen, const Body& a, const Body& b) const;
   void carryValidContacts(PairState& p, const Body& a, const Body& b, double matchDistance, double drift);
   void reduceCarried(std::vector<SolverContact>& contacts, std::size_t keep);
   std::vector<double> spread;  // reduceCarried's farthest-point distances
@@ -328,6 +337,7 @@ BodyId World::addBody(const RigidBodyDesc& d) {
   b.x = d.position + b.q * b.comLocal;
   b.localBox = d.shape->mesh().bounds();
   b.minExtent = b.localBox.extent().minCoeff();
+  b.frameReach = b.localBox.min.cwiseAbs().cwiseMax(b.localBox.max.cwiseAbs()).norm();
   if (d.type == BodyType::kDynamic) {
     if (!(d.mass > 0.0 && std::isfinite(d.mass))) bad("mass must be > 0 and finite");
     if (!d.inertia.allFinite()) bad("inertia must be finite");
@@ -447,6 +457,19 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     // every substep -- a contact-tree stack at 1,024 tests per frame spent ~1 s of CPU per
     // simulated s doing so -- and the budget it leaves goes to the pairs that can use it, so a
     // resting pair is refined further whenever it is offered more than before.
+    // Proven apart (QueryResult::separation): while no point of B can have moved against A by the
+    // gap the last query proved, the surfaces are still that far apart -- no query, no budget, and
+    // under a time budget no roots' answer either (the pair cannot be arriving). In a pile most
+    // broad-phase pairs are neighbours a little apart, and each was answered every substep.
+    if (p->contacts.empty() && p->apartBy > 0.0 && reachSinceQuery(*p, a, bb) < p->apartBy) {
+      pr.provenApart = true;
+      pr.skipped = pr.reused = false;
+      ++report.pairsProvenApart;
+      p->stale = 0;
+      --left;
+      continue;
+    }
+    pr.provenApart = false;
     const bool improvable = p->interrupted && (!limited || evenShare > p->share);
     if ((p->reusable || (p->interrupted && !improvable && !p->contacts.empty() && s.reuseMotionRel > 0.0)) &&
         reuseManifold(*p, a, bb)) {
@@ -469,9 +492,33 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     // bunny landing at 4 m/s under 50 us per frame at 60 Hz turned about its first contact for
     // 12 skipped substeps (the impact's answers had used the frame's time) and its other side
     // entered the floor 3.5 % of its diagonal, with every model.
-    const bool blind = timed && (p->contacts.empty() ||
-                                 motionSinceQuery(*p, a, bb) > kArrivalTravelRel * std::min(a.desc.shape->diagonal(),
-                                                                                            bb.desc.shape->diagonal()));
+    const double arrival = kArrivalTravelRel * std::min(a.desc.shape->diagonal(), bb.desc.shape->diagonal());
+    const bool blind = timed && (p->contacts.empty() || motionSinceQuery(*p, a, bb) > arrival);
+    if (blind && p->contacts.empty() && (!p->proofFailed || reachSince(p->proofFailedAt, a, bb) > arrival)) {
+      // A pair without contacts under a time budget is answered whatever the budget has left (it
+      // may be arriving); first try to prove it apart from the sphere-trees alone, which costs
+      // ~1 us where the contact tree's roots' answer costs ~30: a pile's neighbours a little
+      // apart were answered from the roots every substep (docs/dynamics.md, "Proven apart"). A
+      // failed proof is not tried again before the pair has moved by the arrival travel (two
+      // boxes 4 cm apart are closer than their leaf spheres are loose: 128 tests per substep
+      // for nothing). Its tests are units of work like any test (the time conversion).
+      std::uint64_t proofTests = 0;
+      const double gap = proveApart(*a.desc.shape, a.pose(), *bb.desc.shape, bb.pose(), kProofTests, scratch, &proofTests);
+      report.testsSpent += proofTests;
+      report.unitsWorked += proofTests;
+      p->proofFailed = !(gap > 0.0);
+      if (p->proofFailed) p->proofFailedAt = a.pose().inverse() * bb.pose();
+      if (gap > 0.0) {
+        p->apartBy = gap;
+        p->queriedAt = a.pose().inverse() * bb.pose();
+        pr.provenApart = true;
+        pr.skipped = pr.reused = false;
+        ++report.pairsProvenApart;
+        p->stale = 0;
+        --left;
+        continue;
+      }
+    }
     if (limited) {
       if (remaining == 0 && !blind) {
         skip();
@@ -549,6 +596,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     // Only a finished answer with contacts is reused: an empty one says nothing about how near
     // the bodies are, and a new contact region could open within any motion.
     p->reusable = result.finished && !result.contacts.empty() && s.reuseMotionRel > 0.0;
+    p->apartBy = result.separation;
     p->queriedAt = a.pose().inverse() * bb.pose();
     p->share = evenShare;
     p->keptFiner = false;
@@ -703,6 +751,19 @@ double World::Impl::motionSinceQuery(const PairState& p, const Body& a, const Bo
   const Pose moved = p.queriedAt.inverse() * (a.pose().inverse() * b.pose());
   const double angle = 2.0 * std::atan2(moved.rotation.vec().norm(), std::abs(moved.rotation.w()));
   return moved.translation.norm() + angle * b.desc.shape->diagonal();
+}
+
+// The farthest any point of B can have moved in A's frame since the pair's last query: B's
+// translation there plus the rotation angle times B's farthest point from its mesh origin, a
+// bound (|(R - I) p| <= angle |p|) that QueryResult::separation can be held against.
+double World::Impl::reachSinceQuery(const PairState& p, const Body& a, const Body& b) const {
+  return reachSince(p.queriedAt, a, b);
+}
+
+double World::Impl::reachSince(const Pose& bInAThen, const Body& a, const Body& b) const {
+  const Pose moved = bInAThen.inverse() * (a.pose().inverse() * b.pose());
+  const double angle = 2.0 * std::atan2(moved.rotation.vec().norm(), std::abs(moved.rotation.w()));
+  return moved.translation.norm() + angle * b.frameReach;
 }
 
 // Persistent contacts (as Bullet's persistent manifold and Box2D's contact ids do it): each new

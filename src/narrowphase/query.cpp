@@ -409,16 +409,22 @@ public:
   Traversal(const SideA& a, const SideB& b, const Pose& xfAFromB, Meter& meter, std::uint64_t directPairs)
       : a_(a), b_(b), xfAFromB_(xfAFromB), xfBFromA_(xfAFromB.inverse()), meter_(meter), directPairs_(directPairs) {}
 
+  // `penetration` is the spheres' overlap, negative for separated spheres: minus their gap, which
+  // a separated pair keeps as its priority (QueryResult::separation).
   TestOutcome test(const Vec3& centerA, double radiusA, const Vec3& centerBinA, double radiusB, double& penetration) {
     if (!meter_.take()) return TestOutcome::kOutOfBudget;
     const double d2 = (centerA - centerBinA).squaredNorm();
     const double rr = radiusA + radiusB;
-    if (d2 > rr * rr) return TestOutcome::kSeparated;
     penetration = rr - std::sqrt(d2);
-    return TestOutcome::kOverlap;
+    return d2 > rr * rr ? TestOutcome::kSeparated : TestOutcome::kOverlap;
   }
 
   Vec3 centerB(const NB& n) const { return xfAFromB_.apply(b_.center(n)); }
+
+  // The smallest gap between the bounding spheres of the pairs found separated so far (infinity
+  // before any; 0 once a cell's plane, not the spheres, separated a pair: QueryResult::separation).
+  double smallestGap() const { return smallestGap_; }
+  void noteSeparated(double penetration) { smallestGap_ = std::min(smallestGap_, std::max(0.0, -penetration)); }
 
   // A final cell's plane proves the pair apart (CellSide::outsidePlane); never for spheres.
   bool planeSeparates(const NA& a, const NB& b) const {
@@ -440,6 +446,7 @@ public:
       if (o == TestOutcome::kOverlap) {
         front.push_back({p.a, p.b, pen});
       } else if (o == TestOutcome::kSeparated) {
+        noteSeparated(pen);
         if (separated) separated->push_back({p.a, p.b, pen});
       } else if (assumeOverlap) {
         front.push_back(p);
@@ -501,8 +508,9 @@ public:
             if (o == TestOutcome::kOverlap && planeSeparates(c, p.b)) o = TestOutcome::kSeparated;
             if (o == TestOutcome::kOverlap) {
               next.push_back({c, p.b, pen});
-            } else if (separated) {
-              separated->push_back({c, p.b, pen});
+            } else {
+              noteSeparated(pen);
+              if (separated) separated->push_back({c, p.b, pen});
             }
           }
         } else {
@@ -519,8 +527,9 @@ public:
             if (o == TestOutcome::kOverlap && planeSeparates(p.a, c)) o = TestOutcome::kSeparated;
             if (o == TestOutcome::kOverlap) {
               next.push_back({p.a, c, pen});
-            } else if (separated) {
-              separated->push_back({p.a, c, pen});
+            } else {
+              noteSeparated(pen);
+              if (separated) separated->push_back({p.a, c, pen});
             }
           }
         }
@@ -546,6 +555,7 @@ private:
   MatrixPose xfBFromA_;
   Meter& meter_;
   std::uint64_t directPairs_;
+  double smallestGap_ = std::numeric_limits<double>::infinity();
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -1673,7 +1683,7 @@ void learnAnswerCost(const AnswerClock& answer, double& secondsPerPair) {
 template <class SideA, class SideB, class Pair>
 bool traverse(const SideA& sa, const SideB& sb, const Pose& xfAFromB, Meter& meter, std::vector<Pair>& front,
               std::vector<Pair>& next, std::vector<Pair>& separated, bool track, std::vector<Pair>* cachedOverlap,
-              std::vector<Pair>* cachedSeparated, std::uint64_t directPairs) {
+              std::vector<Pair>* cachedSeparated, std::uint64_t directPairs, double& smallestGap) {
   Traversal<SideA, SideB> t(sa, sb, xfAFromB, meter, directPairs);
   front.clear();
   separated.clear();
@@ -1688,7 +1698,9 @@ bool traverse(const SideA& sa, const SideB& sb, const Pose& xfAFromB, Meter& met
     next.push_back({sa.root(), sb.root(), 0.0});
     t.retest(next, false, front, sep);
   }
-  return t.refine(front, next, sep);
+  const bool finished = t.refine(front, next, sep);
+  smallestGap = t.smallestGap();
+  return finished;
 }
 
 }  // namespace
@@ -1733,6 +1745,7 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
   const bool warm = c != nullptr && c->valid && c->a == &a && c->b == &b && c->cells == cells;
   bool finished = false;
   bool exactInterrupted = false;
+  double smallestGap = 0.0;  // the traversal's, QueryResult::separation
 
   const bool surfaceModel = model == ContactModel::kExact || model == ContactModel::kContactTree;
   const bool convexPair = surfaceModel && a.patchIsWholeConvexBody(0) && b.patchIsWholeConvexBody(0);
@@ -1762,7 +1775,7 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
     const SphereSide sb{b.sphereTree(), b, cap, wholeBodyIsLeaf};
     finished = traverse(sa, sb, xfAFromB, meter, s.sphereFront, s.sphereNext, s.sphereSeparated, c != nullptr,
                         warm ? &c->sphereOverlapping : nullptr, warm ? &c->sphereSeparated : nullptr,
-                        model == ContactModel::kExact ? kExactDirectPairs : 0);
+                        model == ContactModel::kExact ? kExactDirectPairs : 0, smallestGap);
     fillFrontier(s.sphereFront, sa, sb, result);
     if (model == ContactModel::kExact) {
       const bool complete =
@@ -1814,7 +1827,7 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
     const CellSide sa{a.contactTree(), settings.maxLevel};
     const CellSide sb{b.contactTree(), settings.maxLevel};
     finished = traverse(sa, sb, xfAFromB, meter, s.cellFront, s.cellNext, s.cellSeparated, c != nullptr,
-                        warm ? &c->cellOverlapping : nullptr, warm ? &c->cellSeparated : nullptr, 0);
+                        warm ? &c->cellOverlapping : nullptr, warm ? &c->cellSeparated : nullptr, 0, smallestGap);
     fillFrontier(s.cellFront, sa, sb, result);
     ContactSamplingSettings sampling = settings.contactSampling;
     sampling.maxDepth = kContactTreeLeafDepth;
@@ -1909,8 +1922,42 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
   result.tests = meter.used();
   result.sphereTests = result.tests - result.triangleTests;
   result.finished = finished && !meter.stopped();
+  // Proven apart: a finished traversal with an empty answer frontier separated every pair by its
+  // bounding spheres, which hold the surfaces, so the smallest such gap bounds the surfaces'
+  // distance (a convex pair's separating-axis answer is not a traversal: 0).
+  const bool frontEmpty = cells ? s.cellFront.empty() : s.sphereFront.empty();
+  result.separation = !convexPair && result.finished && frontEmpty && result.contacts.empty() && std::isfinite(smallestGap)
+                          ? smallestGap
+                          : 0.0;
   result.stop = result.finished ? QueryStop::kFinished : (meter.stopped() ? meter.stop() : QueryStop::kTestBudget);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+double proveApart(const CollisionBody& a, const Pose& xfWorldFromA, const CollisionBody& b, const Pose& xfWorldFromB,
+                  std::uint64_t maxTests, QueryScratch& scratch, std::uint64_t* testsUsed) {
+  if (testsUsed != nullptr) *testsUsed = 0;
+  if (maxTests == 0) return 0.0;
+  QueryScratch::Impl& s = scratch.impl();
+  const Pose xfAFromB = xfWorldFromA.inverse() * xfWorldFromB;
+  Meter meter(QueryBudget::tests(maxTests), 0.0);
+  const SphereSide sa{a.sphereTree(), a, UINT32_MAX};
+  const SphereSide sb{b.sphereTree(), b, UINT32_MAX};
+  double gap = 0.0;
+  using SpherePairs = std::vector<SpherePair>;
+  const bool finished = traverse(sa, sb, xfAFromB, meter, s.sphereFront, s.sphereNext, s.sphereSeparated, false,
+                                 static_cast<SpherePairs*>(nullptr), static_cast<SpherePairs*>(nullptr), 0, gap);
+  std::uint64_t used = meter.used();
+  double proven = 0.0;
+  if (finished && !meter.stopped() && s.sphereFront.empty() && std::isfinite(gap) && gap > 0.0) {
+    // Apart surfaces with one closed body inside the other are the deepest overlap there is.
+    bool contained = false;
+    s.raw.clear();
+    used += detail::containmentContacts(a, b, xfAFromB, 1, false, s.containment, s.raw, contained);
+    s.raw.clear();
+    if (!contained) proven = gap;
+  }
+  if (testsUsed != nullptr) *testsUsed = used;
+  return proven;
 }
 
 QueryResult queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const CollisionBody& b,
