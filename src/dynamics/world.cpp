@@ -147,32 +147,38 @@ struct PairState {
 
 std::uint64_t pairKey(BodyId a, BodyId b) { return (std::uint64_t(a) << 32) | b; }
 
-// One friction update of a contact: an impulse against the sliding velocity (v1, v2 along t1,
-// t2) that stops its component along that velocity -- its size 1 / (d^T K d) per unit speed, d
-// the sliding direction, K the tangent inverse mass -- added to the accumulated tangential
-// impulse, and the sum clamped to the Coulomb cone |lambdaT| <= limit (mu times the normal
-// impulse). Why the step is along the velocity: a sliding contact's accumulated impulse settles
-// where the step is parallel to it, so it ends parallel to the sliding velocity -- Coulomb's
-// maximal dissipation. A step scaled per tangent (mass_t1 v1, mass_t2 v2) settles parallel to
-// that scaled velocity instead, and a box whose corners have different tangent masses (any box
+// One step of a two-axis dissipative constraint in the plane (u1, u2): an impulse against the
+// velocity (v1, v2) that stops its component along that velocity -- its size 1 / (d^T K d) per
+// unit speed, d the velocity's direction, K the constraint's 2 x 2 inverse mass -- added to the
+// accumulated impulse (l1, l2), and the sum clamped to the disc of radius `limit`. Why the step
+// is along the velocity: projected iterations settle where the step is parallel to the
+// accumulated impulse, so a slipping constraint's impulse ends anti-parallel to its velocity
+// (Coulomb's maximal dissipation). A step scaled per axis (mass_1 v1, mass_2 v2) settles parallel
+// to that scaled velocity instead, and a box whose corners have different tangent masses (any box
 // sliding off the world axes) was pushed sideways and spun: it slid 7 % too far and turned 5 deg
-// off its heading. Clamping each tangent on its own (a friction pyramid) is worse still: up to
-// sqrt 2 times mu N, along the diagonal. Returns the impulse change (world).
-Vec3 frictionStep(SolverContact& cp, double v1, double v2, const TangentInverseMass& k, double limit) {
-  const double old1 = cp.lambdaT1, old2 = cp.lambdaT2;
+// off its heading. Clamping each axis on its own (a friction pyramid) is worse still: up to sqrt 2
+// times the limit, along the diagonal. Returns false when there is nothing to stop.
+bool coneStep(double& l1, double& l2, double v1, double v2, const TangentInverseMass& k, double limit) {
   const double speedSq = v1 * v1 + v2 * v2;
   const double kAlong = speedSq > 0.0 ? (v1 * (k.k11 * v1 + k.k12 * v2) + v2 * (k.k12 * v1 + k.k22 * v2)) / speedSq : 0.0;
-  if (!(kAlong > 0.0)) return Vec3::Zero();  // no sliding, or nothing that can move
-  double l1 = old1 - v1 / kAlong, l2 = old2 - v2 / kAlong;
+  if (!(kAlong > 0.0)) return false;  // no motion, or nothing that can move
+  l1 -= v1 / kAlong;
+  l2 -= v2 / kAlong;
   const double length = std::hypot(l1, l2);
   if (length > limit) {
     const double scale = limit > 0.0 ? limit / length : 0.0;
     l1 *= scale;
     l2 *= scale;
   }
-  cp.lambdaT1 = l1;
-  cp.lambdaT2 = l2;
-  return (l1 - old1) * cp.t1 + (l2 - old2) * cp.t2;
+  return true;
+}
+
+// One friction update of a contact (coneStep on its tangents t1, t2 with the Coulomb cone
+// |lambdaT| <= limit, mu times the normal impulse). Returns the impulse change (world).
+Vec3 frictionStep(SolverContact& cp, double v1, double v2, const TangentInverseMass& k, double limit) {
+  const double old1 = cp.lambdaT1, old2 = cp.lambdaT2;
+  if (!coneStep(cp.lambdaT1, cp.lambdaT2, v1, v2, k, limit)) return Vec3::Zero();
+  return (cp.lambdaT1 - old1) * cp.t1 + (cp.lambdaT2 - old2) * cp.t2;
 }
 
 void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
@@ -1031,7 +1037,7 @@ void World::Impl::solve(double h) {
   // Rolling resistance (WorldSettings::rollingResistanceRel): the bodies' relative turn about
   // the pair's tangent axes (those of its mean contact normal) is resisted by an angular impulse
   // of at most rollingResistanceRel x the smaller diagonal x the pair's normal impulse, stepped
-  // along the turn as friction is (frictionStep) and not warm-started (its limit follows the
+  // along the turn as friction is (coneStep) and not warm-started (its limit follows the
   // normal impulses of the same sweep).
   const double rollingRel = s.rollingResistanceRel;
   auto rollingStep = [&](PairState& p, Body& a, Body& b) {
@@ -1039,22 +1045,9 @@ void World::Impl::solve(double h) {
     for (const SolverContact& cp : p.contacts) lambdaN += cp.lambdaN;
     const double limit = rollingRel * std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal()) * lambdaN;
     const Vec3 w = a.w - b.w;
-    const double w1 = w.dot(p.rollingU1), w2 = w.dot(p.rollingU2);
-    const TangentInverseMass& k = p.rollingK;
-    const double speedSq = w1 * w1 + w2 * w2;
-    const double kAlong = speedSq > 0.0 ? (w1 * (k.k11 * w1 + k.k12 * w2) + w2 * (k.k12 * w1 + k.k22 * w2)) / speedSq : 0.0;
-    if (!(kAlong > 0.0)) return;
     const double old1 = p.rollingL1, old2 = p.rollingL2;
-    double l1 = old1 - w1 / kAlong, l2 = old2 - w2 / kAlong;
-    const double length = std::hypot(l1, l2);
-    if (length > limit) {
-      const double scale = limit > 0.0 ? limit / length : 0.0;
-      l1 *= scale;
-      l2 *= scale;
-    }
-    p.rollingL1 = l1;
-    p.rollingL2 = l2;
-    const Vec3 impulse = (l1 - old1) * p.rollingU1 + (l2 - old2) * p.rollingU2;
+    if (!coneStep(p.rollingL1, p.rollingL2, w.dot(p.rollingU1), w.dot(p.rollingU2), p.rollingK, limit)) return;
+    const Vec3 impulse = (p.rollingL1 - old1) * p.rollingU1 + (p.rollingL2 - old2) * p.rollingU2;
     a.w += a.invInertiaWorld * impulse;
     b.w -= b.invInertiaWorld * impulse;
   };

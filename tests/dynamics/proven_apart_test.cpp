@@ -21,18 +21,6 @@
 namespace clod {
 namespace {
 
-double bruteForceDistance(const TriangleMesh& ma, const Pose& pa, const TriangleMesh& mb, const Pose& pb) {
-  double best = INFINITY;
-  for (const auto& ta : ma.triangles)
-    for (const auto& tb : mb.triangles) {
-      const auto d = detail::triangleDistance(pa.apply(ma.vertices[ta[0]]), pa.apply(ma.vertices[ta[1]]),
-                                              pa.apply(ma.vertices[ta[2]]), pb.apply(mb.vertices[tb[0]]),
-                                              pb.apply(mb.vertices[tb[1]]), pb.apply(mb.vertices[tb[2]]));
-      best = std::min(best, d.distanceSquared);
-    }
-  return std::sqrt(best);
-}
-
 // Random poses of B around A, from touching-close to a body's size apart, turned at random: every
 // model at 16, 256 tests and unlimited, and proveApart with 64 and 4,096 tests. Whenever a gap is
 // claimed it is at most the brute-force distance (rounding: 1e-9 of the diagonal). Not vacuous:
@@ -55,7 +43,7 @@ TEST(ProvenApart, AClaimedGapIsNeverMoreThanTheSurfacesDistance) {
     const Quat turn(Eigen::AngleAxisd(M_PI * unit(rng), Vec3(gauss(rng), gauss(rng), gauss(rng)).normalized()));
     // Centre distance from 1.0 (the bodies overlap) to 2.2 (a size apart).
     const Pose poseB{turn, (1.0 + 1.2 * unit(rng)) * axis};
-    const double truth = bruteForceDistance(a.mesh(), Pose{}, b.mesh(), poseB);
+    const double truth = test::bruteForceSurfaceDistance(a.mesh(), Pose{}, b.mesh(), poseB);
     const double rounding = 1e-9 * std::max(a.diagonal(), b.diagonal());
     auto check = [&](double claimed, const std::string& what) {
       if (claimed <= 0.0) return;

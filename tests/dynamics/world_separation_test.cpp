@@ -18,6 +18,7 @@
 #include "clod/proximity.h"
 #include "clod/world.h"
 #include "dynamics/separation.h"
+#include "dynamics/world_test_support.h"
 
 namespace clod {
 namespace {
@@ -114,19 +115,6 @@ TEST(WorldSeparation, MaxDistanceStopsEarlyWithALowerBound) {
   EXPECT_TRUE(separationOf(a, b, 10.5).withinMax);
 }
 
-// The minimum over all triangle pairs, the definition the descent must reproduce.
-double bruteForce(const TriangleMesh& ma, const Pose& pa, const TriangleMesh& mb, const Pose& pb) {
-  double best = INFINITY;
-  for (const auto& ta : ma.triangles)
-    for (const auto& tb : mb.triangles) {
-      const auto d = detail::triangleDistance(pa.apply(ma.vertices[ta[0]]), pa.apply(ma.vertices[ta[1]]),
-                                              pa.apply(ma.vertices[ta[2]]), pb.apply(mb.vertices[tb[0]]),
-                                              pb.apply(mb.vertices[tb[1]]), pb.apply(mb.vertices[tb[2]]));
-      best = std::min(best, d.distanceSquared);
-    }
-  return std::sqrt(best);
-}
-
 TEST(WorldSeparation, TessellatedSpheresLieBetweenCircumscribedAndInscribedBallsAndMatchBruteForce) {
   const TriangleMesh mesh = makeIcosphere(1.0, 2);
   static const auto sphere = bake(mesh);
@@ -149,7 +137,7 @@ TEST(WorldSeparation, TessellatedSpheresLieBetweenCircumscribedAndInscribedBalls
     // The mesh lies between the inscribed and the unit ball: the gap between the balls bounds it.
     EXPECT_GE(s.distance, centres - 2.0 - kTol) << trial;
     EXPECT_LE(s.distance, centres - 2.0 * inscribed + kTol) << trial;
-    EXPECT_NEAR(s.distance, bruteForce(mesh, Pose{qa, pa}, mesh, Pose{qb, pb}), kTol) << trial;
+    EXPECT_NEAR(s.distance, test::bruteForceSurfaceDistance(mesh, Pose{qa, pa}, mesh, Pose{qb, pb}), kTol) << trial;
     EXPECT_NEAR((s.pointA - s.pointB).norm(), s.distance, kTol) << trial;
   }
 }

@@ -3,6 +3,8 @@
 // 6, as the scene loader bakes primitives (include/clod/scene.h), so the tests see the trees
 // that `clod simulate` scenes get.
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 
 #include "clod/bake.h"
@@ -10,6 +12,7 @@
 #include "clod/contact_tree_builder.h"
 #include "clod/primitives.h"
 #include "clod/proximity.h"
+#include "dynamics/separation.h"
 
 namespace clod::test {
 
@@ -25,6 +28,21 @@ inline std::shared_ptr<const CollisionBody> bakeWorldShape(const TriangleMesh& m
   ct.maxDepth = 6;
   body->setContactTree(buildContactTree(MeshDistance(mesh), ct));
   return body;
+}
+
+/// The distance between two posed meshes by brute force: the minimum over every triangle pair
+/// (detail::triangleDistance), the definition the world's separation and the narrow phase's
+/// proven gaps are held to.
+inline double bruteForceSurfaceDistance(const TriangleMesh& ma, const Pose& pa, const TriangleMesh& mb, const Pose& pb) {
+  double best = INFINITY;
+  for (const auto& ta : ma.triangles)
+    for (const auto& tb : mb.triangles) {
+      const auto d = detail::triangleDistance(pa.apply(ma.vertices[ta[0]]), pa.apply(ma.vertices[ta[1]]),
+                                              pa.apply(ma.vertices[ta[2]]), pb.apply(mb.vertices[tb[0]]),
+                                              pb.apply(mb.vertices[tb[1]]), pb.apply(mb.vertices[tb[2]]));
+      best = std::min(best, d.distanceSquared);
+    }
+  return std::sqrt(best);
 }
 
 /// A unit cube (side 1) baked as above, once per test binary.
