@@ -454,6 +454,23 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       ++p->stale;
       --left;
     };
+    // Proven apart (QueryResult::separation, proveApart): no query, no budget, no contacts.
+    auto provenApart = [&] {
+      pr.provenApart = true;
+      pr.skipped = pr.reused = false;
+      ++report.pairsProvenApart;
+      p->stale = 0;
+      --left;
+    };
+    // While no point of B can have moved against A by the gap the last query proved, the
+    // surfaces are still that far apart -- and under a time budget the pair needs no roots'
+    // answer either (it cannot be arriving). In a pile most broad-phase pairs are neighbours a
+    // little apart, and each was answered every substep.
+    if (p->contacts.empty() && p->apartBy > 0.0 && reachSinceQuery(*p, a, bb) < p->apartBy) {
+      provenApart();
+      continue;
+    }
+    pr.provenApart = false;
     // A pair's even share of what the substep has left (limited budgets).
     const std::uint64_t evenShare = limited ? std::max<std::uint64_t>(1, remaining / left) : 0;
     // A manifold is reused while the bodies have not moved against each other and a new query
@@ -463,19 +480,6 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     // every substep -- a contact-tree stack at 1,024 tests per frame spent ~1 s of CPU per
     // simulated s doing so -- and the budget it leaves goes to the pairs that can use it, so a
     // resting pair is refined further whenever it is offered more than before.
-    // Proven apart (QueryResult::separation): while no point of B can have moved against A by the
-    // gap the last query proved, the surfaces are still that far apart -- no query, no budget, and
-    // under a time budget no roots' answer either (the pair cannot be arriving). In a pile most
-    // broad-phase pairs are neighbours a little apart, and each was answered every substep.
-    if (p->contacts.empty() && p->apartBy > 0.0 && reachSinceQuery(*p, a, bb) < p->apartBy) {
-      pr.provenApart = true;
-      pr.skipped = pr.reused = false;
-      ++report.pairsProvenApart;
-      p->stale = 0;
-      --left;
-      continue;
-    }
-    pr.provenApart = false;
     const bool improvable = p->interrupted && (!limited || evenShare > p->share);
     if ((p->reusable || (p->interrupted && !improvable && !p->contacts.empty() && s.reuseMotionRel > 0.0)) &&
         reuseManifold(*p, a, bb)) {
@@ -517,11 +521,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       if (gap > 0.0) {
         p->apartBy = gap;
         p->queriedAt = a.pose().inverse() * bb.pose();
-        pr.provenApart = true;
-        pr.skipped = pr.reused = false;
-        ++report.pairsProvenApart;
-        p->stale = 0;
-        --left;
+        provenApart();
         continue;
       }
     }
