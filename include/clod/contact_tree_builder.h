@@ -52,7 +52,10 @@ struct ContactTreeBuildStats {
 };
 
 /// Builds the contact tree of the mesh held by `distance` (its signMethod() decides the sign:
-/// pseudonormals for closed meshes, winding numbers for open ones). O(cells * test points *
+/// pseudonormals for closed meshes, winding numbers for open ones). For an open mesh or one of
+/// several parts the field is the signed distance to the solid's boundary: faces with the solid
+/// on both sides (walls where parts overlap) are left out (solidBoundary), and where
+/// any is, the sign is the winding number's (overlapping parts defeat pseudonormals). O(cells * test points *
 /// exact-query cost); parallel. Throws clod::Error(kInvalidArgument) naming the setting when a
 /// setting is out of range. The mesh itself was validated when `distance` was built.
 ContactTree buildContactTree(const MeshDistance& distance, const ContactTreeSettings& settings = {},

@@ -9,7 +9,9 @@
 #include <tbb/parallel_sort.h>
 
 #include "clod/error.h"
+#include "clod/mesh_validation.h"
 #include "clod/proximity.h"
+#include "clod/solid_boundary.h"
 #include "half_space_code.h"
 #include "lattice.h"
 
@@ -27,6 +29,9 @@ constexpr double kSqrt3 = 1.7320508075688772;
 // the refinement test (measured <= eps / kGapFactor) and for the stored bound (kGapFactor *
 // measured, capped by the rigorous half-diagonal). docs/contact-tree.md has the measurements.
 constexpr double kGapFactor = 2.0;
+// Spacing of the samples that find where a soup's solid boundary crosses a face (solid_boundary.h):
+// a crossing that clips less than this off a face can be missed.
+constexpr double kBoundarySampleSpacingRel = 1.0 / 64.0;
 
 // A cell waiting to be processed: where it is, its corner values as stored (rounded to the
 // value step q, ContactTree::valueStep) and as measured (float-rounded exact values: the
@@ -393,6 +398,19 @@ ContactTree Builder::build(ContactTreeBuildStats* stats) {
 
 ContactTree buildContactTree(const MeshDistance& distance, const ContactTreeSettings& settings, ContactTreeBuildStats* stats) {
   checkSettings(settings);
+  // A soup of overlapping parts has walls inside its solid: the field is the distance to the
+  // solid's boundary (solid_boundary.h), and a wall's -|d| kink would be refined to the tree's
+  // depth on both sides. One closed manifold part has no walls.
+  if (distance.signMethod() == SignMethod::kWindingNumber || validateMesh(distance.mesh()).components > 1) {
+    // Wall pieces are left within eps of the crossings, about what the field may be off by.
+    const double diag = distance.mesh().bounds().diagonal();
+    const SolidBoundary boundary = solidBoundary(distance, settings.errorRel * diag, kBoundarySampleSpacingRel * diag);
+    if (boundary.changed()) {
+      const MeshDistance solid(boundary.mesh, MeshDistanceSettings{.forceWindingNumber = true});
+      Builder builder(solid, settings);
+      return builder.build(stats);
+    }
+  }
   Builder builder(distance, settings);
   return builder.build(stats);
 }
