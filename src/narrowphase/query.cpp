@@ -632,6 +632,21 @@ double patchSupport(const CollisionBody& body, std::uint32_t sphere, const Vec3&
   return support;
 }
 
+// [min, max] of n . v over the vertices `ids` of the body, in one pass (the separating-axis
+// test needs both ends of every projection).
+struct Extent {
+  double lo, hi;
+};
+Extent vertexExtent(const CollisionBody& body, std::span<const std::uint32_t> ids, const Vec3& nLocal) {
+  Extent e{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+  for (std::uint32_t i : ids) {
+    const double x = nLocal.dot(body.mesh().vertices[i]);
+    e.lo = std::min(e.lo, x);
+    e.hi = std::max(e.hi, x);
+  }
+  return e;
+}
+
 // One side of a sphere pair as a support function in A's frame: the faceted patch of the sphere
 // (its vertices, CollisionBody::spherePatchVertices) when it has one, else the sphere itself,
 // which bounds whatever surface the sphere is responsible for. Both are conservative: they
@@ -661,6 +676,22 @@ struct PatchSide {
     for (std::uint32_t v : ids) best = std::max(best, nLocal.dot(body.mesh().vertices[v]));
     return std::min(ofSphere, best + n.dot(shift) + body.sphereSupportSlack(sphere));
   }
+
+  // [-support(-n), support(n)] in one pass over the vertices.
+  Extent extent(const Vec3& n) const {
+    const Vec3 nLocal = rotToA ? Vec3(rotToA->transpose() * n) : n;
+    const double along = n.dot(shift);
+    if (faceted) {
+      const Extent e = vertexExtent(body, body.spherePatchVertices(sphere), nLocal);
+      return {e.lo + along, e.hi + along};
+    }
+    const double c = n.dot(centre);
+    const std::span<const std::uint32_t> ids = body.sphereSupportVertices(sphere);
+    if (ids.empty()) return {c - radius, c + radius};
+    const Extent e = vertexExtent(body, ids, nLocal);
+    const double slack = body.sphereSupportSlack(sphere);
+    return {std::max(c - radius, e.lo + along - slack), std::min(c + radius, e.hi + along + slack)};
+  }
 };
 
 // Separating-axis choice between two sphere patches of which at least one is faceted. Candidate
@@ -684,12 +715,9 @@ PatchAxis leastOverlapNormal(const PatchSide& sideA, const PatchSide& sideB, con
   bool apart = false;
   auto consider = [&](const Vec3& n) {  // n in A's frame; both n and -n are tried
     if (apart) return;  // one separating axis settles it
-    const double maxB = sideB.support(n);
-    const double minB = -sideB.support(-n);
-    const double maxA = sideA.support(n);
-    const double minA = -sideA.support(-n);
-    const double alongN = maxB - minA;   // push A along +n by this much to separate
-    const double againstN = maxA - minB; // or along -n by this much
+    const Extent a = sideA.extent(n), b = sideB.extent(n);
+    const double alongN = b.hi - a.lo;   // push A along +n by this much to separate
+    const double againstN = a.hi - b.lo; // or along -n by this much
     if (alongN < 0.0 || againstN < 0.0) {
       apart = true;  // the projections do not overlap: a separating axis
       return;
