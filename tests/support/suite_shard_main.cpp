@@ -5,8 +5,8 @@
 // single tests round robin, so every shard ran a few tests of every suite and built each suite's
 // shared fixture (a baked body, a contact tree: SetUpTestSuite, function statics) again: under
 // the sanitizers the narrow-phase runner's three shards cost twice the CPU of one process.
-// Suites go to the shard with the fewest tests so far, largest suites first: deterministic, and
-// about as balanced as GoogleTest's split. A --gtest_filter given by hand runs unsharded.
+// Suites go to the shard with the fewest tests so far, largest first (a suite too large for one
+// shard is dealt out test by test): deterministic. A --gtest_filter given by hand runs unsharded.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -21,22 +21,39 @@ int envInt(const char* name, int fallback) {
   return value && *value ? std::atoi(value) : fallback;
 }
 
-std::string suiteFilter(int shards, int index) {
+// A unit of work for one shard: a whole suite, or one test of a suite too large to keep whole.
+struct Unit {
+  std::string pattern;  // "Suite.*" or "Suite.Test"
+  int tests;
+};
+
+std::vector<Unit> units(int shards) {
   const testing::UnitTest& unit = *testing::UnitTest::GetInstance();
-  struct Suite {
-    std::string name;
-    int tests;
-  };
-  std::vector<Suite> suites;
-  for (int i = 0; i < unit.total_test_suite_count(); ++i)
-    suites.push_back({unit.GetTestSuite(i)->name(), unit.GetTestSuite(i)->total_test_count()});
-  std::stable_sort(suites.begin(), suites.end(), [](const Suite& a, const Suite& b) { return a.tests > b.tests; });
+  const int perShard = unit.total_test_count() / shards;
+  std::vector<Unit> out;
+  for (int i = 0; i < unit.total_test_suite_count(); ++i) {
+    const testing::TestSuite& suite = *unit.GetTestSuite(i);
+    // A suite holding more than half a shard's share is dealt out test by test: left whole it
+    // would make one shard the run's tail (the world's main suite has most of its tests).
+    if (suite.total_test_count() * 2 <= perShard) {
+      out.push_back({std::string(suite.name()) + ".*", suite.total_test_count()});
+      continue;
+    }
+    for (int t = 0; t < suite.total_test_count(); ++t)
+      out.push_back({std::string(suite.name()) + "." + suite.GetTestInfo(t)->name(), 1});
+  }
+  return out;
+}
+
+std::string shardFilter(int shards, int index) {
+  std::vector<Unit> work = units(shards);
+  std::stable_sort(work.begin(), work.end(), [](const Unit& a, const Unit& b) { return a.tests > b.tests; });
   std::vector<int> load(static_cast<std::size_t>(shards), 0);
   std::string filter;
-  for (const Suite& suite : suites) {
+  for (const Unit& u : work) {
     const auto shard = static_cast<int>(std::min_element(load.begin(), load.end()) - load.begin());
-    load[static_cast<std::size_t>(shard)] += suite.tests;
-    if (shard == index) filter += suite.name + ".*:";
+    load[static_cast<std::size_t>(shard)] += u.tests;
+    if (shard == index) filter += u.pattern + ":";
   }
   return filter.empty() ? "-*" : filter;
 }
@@ -48,6 +65,6 @@ int main(int argc, char** argv) {
   const int shards = envInt("CLOD_SUITE_SHARDS", 1);
   const int index = envInt("CLOD_SUITE_SHARD_INDEX", 0);
   if (shards > 1 && index >= 0 && index < shards && GTEST_FLAG_GET(filter) == "*")
-    GTEST_FLAG_SET(filter, suiteFilter(shards, index));
+    GTEST_FLAG_SET(filter, shardFilter(shards, index));
   return RUN_ALL_TESTS();
 }
