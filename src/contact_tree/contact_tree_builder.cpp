@@ -405,7 +405,7 @@ ContactTree buildContactTree(const MeshDistance& distance, const ContactTreeSett
     // Wall pieces are left within eps of the crossings, about what the field may be off by.
     const double diag = distance.mesh().bounds().diagonal();
     const SolidBoundary boundary = solidBoundary(distance, settings.errorRel * diag, kBoundarySampleSpacingRel * diag);
-    if (boundary.changed()) {
+    if (boundary.changed() && !boundary.mesh.triangles.empty()) {
       const MeshDistance solid(boundary.mesh, MeshDistanceSettings{.forceWindingNumber = true});
       Builder builder(solid, settings);
       return builder.build(stats);

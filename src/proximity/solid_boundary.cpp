@@ -46,9 +46,17 @@ struct FaceSplitter {
   double resolution, sampleSpacing;
   Vec3 offset;
   std::vector<Corners>& pieces;
+  std::uint32_t splitsLeft;  // bounds the work and the pieces of one face (hostile soups)
 
   bool keep(const Corners& t) {
     const double edge = longestEdge(t);
+    if (splitsLeft == 0) {
+      // Out of budget: keep the piece (a wall left in costs field quality, a hole would cost
+      // the sign); drop it only when it was sampled finely enough and lies wholly inside.
+      const bool inside = edge <= sampleSpacing && classify(distance, t, offset) == Verdict::kInterior;
+      if (!inside) pieces.push_back(t);
+      return false;
+    }
     if (edge <= sampleSpacing) {
       const Verdict v = classify(distance, t, offset);
       if (v == Verdict::kInterior) return false;
@@ -57,6 +65,7 @@ struct FaceSplitter {
         return v == Verdict::kBoundary;
       }
     }
+    --splitsLeft;
     const Vec3 m01 = 0.5 * (t[0] + t[1]), m12 = 0.5 * (t[1] + t[2]), m20 = 0.5 * (t[2] + t[0]);
     bool whole = keep({t[0], m01, m20});
     whole &= keep({m01, t[1], m12});
@@ -77,6 +86,10 @@ SolidBoundary solidBoundary(const MeshDistance& distance, double resolution, dou
   // The sample points only have to stay off their face and nearer to it than to any other.
   const double offsetLength = 1e-6 * box.diagonal();
 
+  // Each split makes 4 pieces and at most 4 classifications (8 winding numbers each): a face
+  // gets up to 2^20 / T splits, at least 4, so a soup of many large crossing faces stays
+  // proportional to its size.
+  const std::uint32_t splitsPerFace = std::max<std::uint32_t>(4, (1u << 20) / std::max<std::uint32_t>(1, mesh.triangleCount()));
   enum : std::uint8_t { kWhole, kDropped, kSplit };
   std::vector<std::uint8_t> fate(mesh.triangleCount(), kWhole);
   std::vector<std::vector<Corners>> pieces(mesh.triangleCount());
@@ -87,7 +100,7 @@ SolidBoundary solidBoundary(const MeshDistance& distance, double resolution, dou
       if (twiceArea == 0.0) continue;
       // A sliver's samples lie close to its neighbours: stay much nearer than its width.
       const Vec3 offset = std::min(offsetLength, 1e-3 * std::sqrt(twiceArea)) / twiceArea * cross;
-      FaceSplitter splitter{distance, resolution, sampleSpacing, offset, pieces[t]};
+      FaceSplitter splitter{distance, resolution, sampleSpacing, offset, pieces[t], splitsPerFace};
       if (splitter.keep({mesh.corner(t, 0), mesh.corner(t, 1), mesh.corner(t, 2)})) {
         pieces[t].clear();
         pieces[t].shrink_to_fit();
