@@ -31,9 +31,9 @@ struct SolidBoundary {
 /// whose samples disagree are split until their edges are shorter than `resolution` and then
 /// kept. A face that bounds the solid everywhere it was sampled is kept whole. So a wall piece
 /// is left only within `resolution` of where the boundary crosses a face, and a crossing that
-/// falls between samples `sampleSpacing` apart can be missed. Degenerate faces are kept. A face
-/// is split at most max(4, 2^20 / T) times (T triangles); beyond that its pieces are kept whole,
-/// so the work and the output stay O(2^20 + T) whatever the soup.
+/// falls between samples `sampleSpacing` apart can be missed. Degenerate faces are kept. Bounded
+/// work whatever the soup: the spacing grows so that the coarse samples are at most ~2^17, and a
+/// face's mixed pieces are split at most max(16, 2^16 / T) times (T triangles), then kept.
 /// Preconditions: 0 < resolution <= sampleSpacing (kInvalidArgument otherwise). Parallel.
 SolidBoundary solidBoundary(const MeshDistance& distance, double resolution, double sampleSpacing);
 

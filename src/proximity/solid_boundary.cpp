@@ -50,22 +50,16 @@ struct FaceSplitter {
 
   bool keep(const Corners& t) {
     const double edge = longestEdge(t);
-    if (splitsLeft == 0) {
-      // Out of budget: keep the piece (a wall left in costs field quality, a hole would cost
-      // the sign); drop it only when it was sampled finely enough and lies wholly inside.
-      const bool inside = edge <= sampleSpacing && classify(distance, t, offset) == Verdict::kInterior;
-      if (!inside) pieces.push_back(t);
-      return false;
-    }
     if (edge <= sampleSpacing) {
       const Verdict v = classify(distance, t, offset);
       if (v == Verdict::kInterior) return false;
-      if (v == Verdict::kBoundary || edge <= resolution) {
+      // Out of splits, a mixed piece is kept: a wall left in costs field quality, a hole the sign.
+      if (v == Verdict::kBoundary || edge <= resolution || splitsLeft == 0) {
         pieces.push_back(t);
         return v == Verdict::kBoundary;
       }
+      --splitsLeft;
     }
-    --splitsLeft;
     const Vec3 m01 = 0.5 * (t[0] + t[1]), m12 = 0.5 * (t[1] + t[2]), m20 = 0.5 * (t[2] + t[0]);
     bool whole = keep({t[0], m01, m20});
     whole &= keep({m01, t[1], m12});
@@ -86,10 +80,14 @@ SolidBoundary solidBoundary(const MeshDistance& distance, double resolution, dou
   // The sample points only have to stay off their face and nearer to it than to any other.
   const double offsetLength = 1e-6 * box.diagonal();
 
-  // Each split makes 4 pieces and at most 4 classifications (8 winding numbers each): a face
-  // gets up to 2^20 / T splits, at least 4, so a soup of many large crossing faces stays
-  // proportional to its size.
-  const std::uint32_t splitsPerFace = std::max<std::uint32_t>(4, (1u << 20) / std::max<std::uint32_t>(1, mesh.triangleCount()));
+  // The work is classifications, 8 winding numbers each. The coarse sampling makes about
+  // 2 area / spacing^2 of them: a soup with more surface than 2^17 such pieces is sampled
+  // coarser. Each split of a mixed piece makes 4 more: a face gets up to 2^16 / T splits, at
+  // least 16. So a soup of many large crossing faces stays O(2^17 + T) classifications.
+  double area = 0.0;
+  for (std::uint32_t t = 0; t < mesh.triangleCount(); ++t) area += 0.5 * mesh.triangleCross(t).norm();
+  sampleSpacing = std::max(sampleSpacing, std::sqrt(2.0 * area / double(1u << 17)));
+  const std::uint32_t splitsPerFace = std::max<std::uint32_t>(16, (1u << 16) / std::max<std::uint32_t>(1, mesh.triangleCount()));
   enum : std::uint8_t { kWhole, kDropped, kSplit };
   std::vector<std::uint8_t> fate(mesh.triangleCount(), kWhole);
   std::vector<std::vector<Corners>> pieces(mesh.triangleCount());
