@@ -404,7 +404,9 @@ ContactTree buildContactTree(const MeshDistance& distance, const ContactTreeSett
   if (distance.signMethod() == SignMethod::kWindingNumber || validateMesh(distance.mesh()).components > 1) {
     // Wall pieces are left within eps of the crossings, about what the field may be off by.
     const double diag = distance.mesh().bounds().diagonal();
-    const SolidBoundary boundary = solidBoundary(distance, settings.errorRel * diag, kBoundarySampleSpacingRel * diag);
+    const double resolution = settings.errorRel * diag;
+    const SolidBoundary boundary =
+        solidBoundary(distance, resolution, std::max(resolution, kBoundarySampleSpacingRel * diag));
     if (boundary.changed() && !boundary.mesh.triangles.empty()) {
       const MeshDistance solid(boundary.mesh, MeshDistanceSettings{.forceWindingNumber = true});
       Builder builder(solid, settings);

@@ -77,6 +77,16 @@ TEST(SolidBoundary, KeepsEveryFaceOfAClosedMeshAndOfAnOpenOne) {
   EXPECT_FALSE(solidBoundary(MeshDistance(box), 0.01, 0.1).changed());
 }
 
+TEST(SolidBoundary, ACoarseContactTreeOfASoupBuilds) {
+  // eps_s of 5 % of the diagonal is coarser than the boundary's sample spacing (1/64).
+  ContactTreeSettings coarse;
+  coarse.errorRel = 0.05;
+  coarse.bandRel = 0.05;
+  coarse.cubeMarginRel = 0.1;
+  const ContactTree tree = buildContactTree(MeshDistance(TwoBoxes().soup), coarse);
+  EXPECT_GT(tree.nodeCount(), 1u);
+}
+
 TEST(SolidBoundary, RejectsAResolutionOutOfRange) {
   const MeshDistance box(makeBox(Vec3::Ones()));
   EXPECT_THROW(solidBoundary(box, 0.0, 0.1), Error);
