@@ -622,18 +622,11 @@ bool isFaceNormal(const Vec3& nLocal, std::span<const Vec3f> faces) {
 
 enum class PatchAxis : std::uint8_t { kNotFaceted, kChosen, kApart };
 
-// Support of a faceted sphere's patch in direction nLocal (body-local): max n . v over the
-// vertices of the triangles the sphere is responsible for. Whole triangles, not their part inside
-// the sphere: where a sphere cuts a face just at the other body's edge, the cut would look like a
-// real boundary and make the side face the least-overlap axis.
-double patchSupport(const CollisionBody& body, std::uint32_t sphere, const Vec3& nLocal) {
-  double support = -std::numeric_limits<double>::infinity();
-  for (std::uint32_t i : body.spherePatchVertices(sphere)) support = std::max(support, nLocal.dot(body.mesh().vertices[i]));
-  return support;
-}
-
-// [min, max] of n . v over the vertices `ids` of the body, in one pass (the separating-axis
-// test needs both ends of every projection).
+// [min, max] of n . v over the vertices `ids` of the body (n body-local), in one pass: the
+// separating-axis test needs both ends of every projection. A faceted patch's vertices are those
+// of whole triangles, not of their part inside the sphere: where a sphere cuts a face just at the
+// other body's edge, the cut would look like a real boundary and make the side face the
+// least-overlap axis.
 struct Extent {
   double lo, hi;
 };
@@ -665,19 +658,7 @@ struct PatchSide {
 
   Vec3 toA(const Vec3& local) const { return rotToA ? Vec3(*rotToA * local + shift) : local; }
 
-  // max over the side of n . x, n in A's frame.
-  double support(const Vec3& n) const {
-    const Vec3 nLocal = rotToA ? Vec3(rotToA->transpose() * n) : n;
-    if (faceted) return patchSupport(body, sphere, nLocal) + n.dot(shift);
-    const double ofSphere = n.dot(centre) + radius;
-    const std::span<const std::uint32_t> ids = body.sphereSupportVertices(sphere);
-    if (ids.empty()) return ofSphere;
-    double best = -std::numeric_limits<double>::infinity();
-    for (std::uint32_t v : ids) best = std::max(best, nLocal.dot(body.mesh().vertices[v]));
-    return std::min(ofSphere, best + n.dot(shift) + body.sphereSupportSlack(sphere));
-  }
-
-  // [-support(-n), support(n)] in one pass over the vertices.
+  // [min, max] over the side of n . x, n in A's frame: its support along -n (negated) and n.
   Extent extent(const Vec3& n) const {
     const Vec3 nLocal = rotToA ? Vec3(rotToA->transpose() * n) : n;
     const double along = n.dot(shift);
@@ -778,8 +759,8 @@ Vec3 extremeVertex(const PatchSide& side, std::span<const std::uint32_t> ids, co
 // every level, where the D&O point lies up to a sphere radius inside the upper box and its depth
 // is the spheres' overlap. Returns false when the sides are apart along n.
 bool patchDepthAndPoint(const PatchSide& sideA, const PatchSide& sideB, const Vec3& n, Contact& c) {
-  const double maxB = sideB.support(n);
-  const double minA = -sideA.support(-n);
+  const double maxB = sideB.extent(n).hi;
+  const double minA = sideA.extent(n).lo;
   const double overlap = maxB - minA;
   if (overlap < 0.0) return false;
   c.depth = std::min(c.depth, overlap);
@@ -801,8 +782,9 @@ bool patchDepthAndPoint(const PatchSide& sideA, const PatchSide& sideB, const Ve
   const Vec3 t1 = n.unitOrthogonal();
   const Vec3 t2 = n.cross(t1);
   for (const Vec3& t : {t1, t2}) {
-    const double lo = std::max(-sideA.support(-t), -sideB.support(-t));
-    const double hi = std::min(sideA.support(t), sideB.support(t));
+    const Extent a = sideA.extent(t), b = sideB.extent(t);
+    const double lo = std::max(a.lo, b.lo);
+    const double hi = std::min(a.hi, b.hi);
     if (lo > hi) continue;  // no common extent along t (the sides overlap only along n)
     const double s = t.dot(p);
     p += (std::clamp(s, lo, hi) - s) * t;
@@ -814,7 +796,8 @@ bool patchDepthAndPoint(const PatchSide& sideA, const PatchSide& sideB, const Ve
 // False when the support functions of two sides (patches or spheres) do not overlap along
 // `axis`: a separating axis, the sides cannot touch.
 bool curvedPatchesMayTouch(const PatchSide& sideA, const PatchSide& sideB, const Vec3& axis) {
-  return sideB.support(axis) + sideA.support(-axis) >= 0.0 && sideA.support(axis) + sideB.support(-axis) >= 0.0;
+  const Extent a = sideA.extent(axis), b = sideB.extent(axis);
+  return b.hi - a.lo >= 0.0 && a.hi - b.lo >= 0.0;
 }
 
 // A rule-1 normal within 2 degrees of a face normal of a side becomes that face normal:
@@ -966,7 +949,7 @@ bool vertexOnFaceContacts(const PatchSide& patch, const PatchSide& faceted, cons
   std::array<std::pair<Vec3, double>, CollisionBody::kMaxSphereFaceNormals> halfSpaces;
   for (std::size_t k = 0; k < faces.size(); ++k) {
     const Vec3 f = faceted.rotToA ? Vec3(*faceted.rotToA * faces[k].cast<double>()) : Vec3(faces[k].cast<double>());
-    halfSpaces[k] = {f, body.support(f)};
+    halfSpaces[k] = {f, body.extent(f).hi};
   }
   const double tolerance = 1e-9 * (patch.body.diagonal() + faceted.body.diagonal());
   const bool facetedIsB = toward.dot(c.normal) > 0.0;
