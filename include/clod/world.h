@@ -232,8 +232,9 @@ struct PairReport {
   /// Not queried in the last substep: its last query proved the surfaces apart by a gap
   /// (QueryResult::separation) that the bodies have not moved against each other since.
   bool provenApart = false;
-  /// Exact model: frontier pairs of the last query answered by the cfm (or dos) fallback instead
-  /// of triangle tests (QueryResult::fallbackPairs); 0 at an unlimited budget.
+  /// Frontier pairs of the last query answered by the cfm (or dos) fallback: exact's pairs left
+  /// without triangle tests (QueryResult::fallbackPairs), and the contact tree's pairs answered
+  /// past a time budget's substep time (docs/dynamics.md); 0 at an unlimited budget.
   std::uint64_t fallbackPairs = 0;
   /// The last query's answer was coarser than the pair's manifold, which still held, so the
   /// finer manifold was kept (docs/dynamics.md, "Persistent manifold").
@@ -265,8 +266,9 @@ struct StepReport {
   std::uint64_t pairsReused = 0;     ///< pair queries saved by manifold reuse (PairReport::reused), summed
   std::uint64_t pairsProvenApart = 0;  ///< pair queries saved by a proven gap (PairReport::provenApart), summed
   std::uint64_t pairsInterrupted = 0;///< queries that stopped before the leaves, summed
-  /// Exact model: frontier pairs answered by the cfm / dos fallback, summed over pairs and
-  /// substeps (PairReport::fallbackPairs); 0 for the other models and at an unlimited budget.
+  /// Frontier pairs answered by the cfm / dos fallback, summed over pairs and substeps
+  /// (PairReport::fallbackPairs): exact's and the contact tree's past a time budget; 0 for the
+  /// other models and at an unlimited budget.
   std::uint64_t fallbackPairs = 0;
   std::uint32_t solverIterations = 0;///< velocity iterations used, summed over substeps
   /// Substeps whose warm-started velocity solve gained kinetic energy and was redone from zero

@@ -566,6 +566,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     } else {
       qs.budget = QueryBudget::unlimited();
     }
+    bool pastTimeFallback = false;
     if (timed) {
       // Once the time is gone every remaining pair is skipped without reading the clock again.
       const QueryBudget::TimePoint now = timeUp ? substepDeadline : s.clock();
@@ -577,10 +578,26 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
         }
         p->cache.clear();
         qs.budget = QueryBudget::tests(1);
+        // Past the time, a blind pair gets the cheapest answer that still has surface normals:
+        // the contact tree's roots' answer samples whole root cells (~30 us a pair), the closest
+        // feature maps' costs ~1 us. A pile keeps hundreds of pairs blind per substep, and the
+        // contact tree's time budget of 0.5 ms per frame ran ~70 ms over (docs/benchmarks/world.md).
+        if (qs.model == ContactModel::kContactTree && a.desc.shape->hasClosestFeatureMap() &&
+            bb.desc.shape->hasClosestFeatureMap()) {
+          qs.model = ContactModel::kCfm;
+          pastTimeFallback = true;
+        }
       }
     }
     --left;
     queryContacts(*a.desc.shape, a.pose(), *bb.desc.shape, bb.pose(), qs, scratch, result, &p->cache);
+    if (pastTimeFallback) {
+      // Reported as a fallback (QueryResult's convention): every frontier pair was answered by cfm.
+      result.fallbackPairs = result.frontier.size();
+      result.fallbackModel = ContactModel::kCfm;
+      qs.model = s.model;
+      p->cache.clear();  // a sphere front; the next contact-tree query starts from the roots
+    }
     // Charged as far as the substep has it left (only the roots' answer above may cost more).
     const std::uint64_t fullCost = result.tests + perCell * result.frontier.size();
     const std::uint64_t cost = limited ? std::min(remaining, fullCost) : fullCost;
