@@ -10,6 +10,7 @@
 #include <sstream>
 #include <string>
 
+#include "clod/atomic_directory.h"
 #include "clod/atomic_file.h"
 #include "clod/bake.h"
 #include "clod/debug_layers.h"
@@ -44,9 +45,7 @@ int runExport(const ExportOptions& o) {
   }
   const BakeContents bake = loadBake(o.bake);
   const std::filesystem::path out(o.outDir);
-  std::error_code ec;
-  std::filesystem::create_directories(out, ec);
-  if (ec) throw Error(ErrorCode::kFileWriteFailed, o.outDir + ": cannot create directory: " + ec.message());
+  checkOutputDirectory(out);  // a file or device as OUTDIR: refused before the work
 
   const std::string name =
       bake.sourceName.empty() ? std::filesystem::path(o.bake).stem().string() : bake.sourceName;
@@ -67,8 +66,12 @@ int runExport(const ExportOptions& o) {
 
   const std::string glb = encodeGlb(scene);
   const std::string json = encodeDebugLayers(layers);
-  writeFileAtomically(out / "scene.glb", glb);
-  writeFileAtomically(out / "layers.json", json);
+  // Both as one unit (atomic_directory.h): the viewer never reads a new scene with old layers.
+  static const std::string kOwned[] = {"scene.glb", "layers.json"};
+  replaceDirectoryAtomically(out, kOwned, [&](const std::filesystem::path& staging) {
+    writeFileAtomically(staging / "scene.glb", glb);
+    writeFileAtomically(staging / "layers.json", json);
+  });
   std::size_t samples = 0;
   if (b.cfmSamples)
     for (const CfmSampleLevel& l : *b.cfmSamples) samples += l.points.size() / 3;

@@ -3,7 +3,8 @@
 // and with clod as its mesh collider (clod_mujoco, include/clod/mujoco/collider.h), writing each
 // run as `clod simulate` writes a scene: OUTDIR/mujoco/ and OUTDIR/clod/ each hold
 // trajectory.csv, contacts.csv, summary.json (and with --gltf scene.glb + layers.json for the
-// viewer, docs/viewer-format.md). Built only when MuJoCo is found.
+// viewer, docs/viewer-format.md), both runs written as one unit (replaceDirectoryAtomically: other
+// entries of OUTDIR are carried over). Built only when MuJoCo is found.
 //
 // A "body" of these files is a geom of the model (what the viewer draws), named by the geom's
 // name, else "<body name>/<geom index>": its pose is the geom's, its velocity the geom's
@@ -22,10 +23,13 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "cli_util.h"
+#include "clod/atomic_directory.h"
 #include "clod/atomic_file.h"
 #include "clod/debug_layers.h"
 #include "clod/error.h"
@@ -87,6 +91,7 @@ std::optional<TriangleMesh> geomMesh(const mjModel* m, int g) {
 
 struct RunReport {
   nlohmann::json final = nlohmann::json::object();
+  std::vector<std::pair<std::string, std::string>> files;  ///< name, content: written with the other run's
 };
 
 void appendRow(std::ostringstream& out, std::uint32_t step, double time, const std::string& name, const Pose& p,
@@ -98,8 +103,7 @@ void appendRow(std::ostringstream& out, std::uint32_t step, double time, const s
       << velocity[1] << ',' << velocity[2] << '\n';
 }
 
-RunReport runOnce(const mjModel* m, mujoco::Collider* collider, const MujocoOptions& o, std::uint32_t steps,
-                  const std::filesystem::path& out) {
+RunReport runOnce(const mjModel* m, mujoco::Collider* collider, const MujocoOptions& o, std::uint32_t steps) {
   mujoco::DataPtr data(mj_makeData(m));
   if (!data) throw Error(ErrorCode::kInvalidArgument, o.model + ": MuJoCo could not allocate the model's data");
   mjData* d = data.get();
@@ -257,15 +261,10 @@ RunReport runOnce(const mjModel* m, mujoco::Collider* collider, const MujocoOpti
     layers.frames = std::move(frames);
     layersJson = encodeDebugLayers(layers);
   }
-  std::error_code ec;
-  std::filesystem::create_directories(out, ec);
-  if (ec) throw Error(ErrorCode::kFileWriteFailed, out.string() + ": cannot create directory: " + ec.message());
-  writeFileAtomically(out / "trajectory.csv", traj.str());
-  writeFileAtomically(out / "contacts.csv", contacts.str());
-  writeFileAtomically(out / "summary.json", summary.dump(2) + "\n");
+  report.files = {{"trajectory.csv", traj.str()}, {"contacts.csv", contacts.str()}, {"summary.json", summary.dump(2) + "\n"}};
   if (o.gltf) {
-    writeFileAtomically(out / "scene.glb", glb);
-    writeFileAtomically(out / "layers.json", layersJson);
+    report.files.emplace_back("scene.glb", std::move(glb));
+    report.files.emplace_back("layers.json", std::move(layersJson));
   }
   return report;
 }
@@ -302,8 +301,19 @@ int runMujoco(const MujocoOptions& o) {
   collider.addModel(m);
   const double bakeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - bakeStart).count();
   const std::filesystem::path out(o.outDir);
-  const RunReport own = runOnce(m, nullptr, o, steps, out / "mujoco");
-  const RunReport withClod = runOnce(m, &collider, o, steps, out / "clod");
+  checkOutputDirectory(out);
+  const RunReport own = runOnce(m, nullptr, o, steps);
+  const RunReport withClod = runOnce(m, &collider, o, steps);
+  // Both runs as one unit: OUTDIR/mujoco and OUTDIR/clod never come from different invocations.
+  static const std::string kOwned[] = {"mujoco", "clod"};
+  replaceDirectoryAtomically(out, kOwned, [&](const std::filesystem::path& staging) {
+    for (const auto& [name, run] : {std::pair{"mujoco", &own}, std::pair{"clod", &withClod}}) {
+      std::error_code ec;
+      if (!std::filesystem::create_directory(staging / name, ec))
+        throw Error(ErrorCode::kFileWriteFailed, (staging / name).string() + ": cannot create directory: " + ec.message());
+      for (const auto& [file, content] : run->files) writeFileAtomically(staging / name / file, content);
+    }
+  });
   std::cout << "simulated " << steps << " steps (" << *duration << " s) twice -> " << o.outDir << "/mujoco, "
             << o.outDir << "/clod (" << collider.bakedShapes() << " shapes baked in " << bakeSeconds << " s)\n";
   for (auto it = own.final.begin(); it != own.final.end(); ++it) {

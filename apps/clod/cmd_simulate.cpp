@@ -1,12 +1,13 @@
 // clod simulate SCENE.json -o OUTDIR [--contact-model M] [--budget N] [--budget-us T] [--progress]: runs a JSON
-// scene (scene.h) and writes, atomically, OUTDIR/trajectory.csv
+// scene (scene.h) and writes, as one unit (replaceDirectoryAtomically), OUTDIR/trajectory.csv
 // (step,time,body,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz; step 0 is the initial state),
 // OUTDIR/contacts.csv (step,body_a,body_b,px,py,pz,nx,ny,nz,depth,level; the contacts the solver
 // used in the step's last substep; the normal points from body_b toward body_a, contact.h) and
 // OUTDIR/summary.json ({"bodies": [{"name", "position", "orientation" [w,x,y,z], "velocity",
 // "angular_velocity"}], "energy": [per step, kinetic + potential], "budget_spent": [tests per
 // step], "step_seconds": [wall time per step], "tests_total", "left_bounds": [...], ...}). Baked shapes are cached in
-// OUTDIR/bake-cache, so a second run starts at once.
+// OUTDIR/bake-cache, so a second run starts at once; it and anything else the user keeps in OUTDIR are
+// carried over into the new OUTDIR (atomic_directory.h).
 // With --gltf it also writes OUTDIR/scene.glb and OUTDIR/layers.json (docs/viewer-format.md;
 // simulation_recorder.h: every step, or at most 60 frames per simulated second), and
 // --gltf-layers picks the per-body layers (spheres, cfm, ctree; "none" for frames only).
@@ -22,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_util.h"
+#include "clod/atomic_directory.h"
 #include "clod/atomic_file.h"
 #include "clod/error.h"
 #include "clod/scene.h"
@@ -84,6 +86,7 @@ int runSimulate(const SimulateOptions& o) {
   if (budget) scene.world.budgetTests = *budget;
   if (budgetMicros) scene.world.budgetMicros = *budgetMicros;
   const std::filesystem::path out(o.outDir);
+  checkOutputDirectory(out);  // a file or device as OUTDIR: refused before the work
   std::error_code ec;
   std::filesystem::create_directories(out, ec);
   if (ec) throw Error(ErrorCode::kFileWriteFailed, o.outDir + ": cannot create directory: " + ec.message());
@@ -176,13 +179,19 @@ int runSimulate(const SimulateOptions& o) {
     glb = encodeGlb(recorder->gltfScene());
     layersJson = encodeDebugLayers(recorder->debugLayers(layerOptions));
   }
-  writeFileAtomically(out / "trajectory.csv", traj.str());
-  writeFileAtomically(out / "contacts.csv", contacts.str());
-  writeFileAtomically(out / "summary.json", summary.dump(2) + "\n");
+  // All five as one unit: a kill never leaves this run's files beside an older run's.
+  static const std::string kOwned[] = {"trajectory.csv", "contacts.csv", "summary.json", "scene.glb", "layers.json"};
+  replaceDirectoryAtomically(out, kOwned, [&](const std::filesystem::path& staging) {
+    writeFileAtomically(staging / "trajectory.csv", traj.str());
+    writeFileAtomically(staging / "contacts.csv", contacts.str());
+    writeFileAtomically(staging / "summary.json", summary.dump(2) + "\n");
+    if (recorder) {
+      writeFileAtomically(staging / "scene.glb", glb);
+      writeFileAtomically(staging / "layers.json", layersJson);
+    }
+  });
   std::cout << "simulated " << scene.steps << " steps of " << world.bodyCount() << " bodies -> " << o.outDir << "\n";
   if (recorder) {
-    writeFileAtomically(out / "scene.glb", glb);
-    writeFileAtomically(out / "layers.json", layersJson);
     std::cout << "glTF: scene.glb + layers.json, " << recorder->frameCount() << " frames ("
               << (recorder->frameStride() == 1 ? std::string("every step")
                                                : "every " + std::to_string(recorder->frameStride()) +

@@ -92,7 +92,8 @@ struct BakeContents {
 ///
 /// Checks first that the contents can be decoded again and throws
 /// clod::Error(kInvalidArgument) naming the field otherwise (non-finite coordinates, triangle
-/// indices >= vertex count, an inconsistent sphere-tree: see decodeBake for the list, or
+/// indices >= vertex count, an inconsistent sphere-tree or one that does not bound the mesh:
+/// see decodeBake for the list, or
 /// more than 2^32-1 of anything), so no file that loadBake would reject is ever written.
 std::vector<std::byte> encodeBake(const BakeContents& contents);
 
@@ -104,7 +105,10 @@ std::vector<std::byte> encodeBake(const BakeContents& contents);
 /// strictly increasing to the sphere count, centres finite, radii finite and >= 0, parent and
 /// child ranges pointing into the neighbouring levels and agreeing with each other,
 /// triangleOffsets monotone from 0 to the triangle list size, triangle indices < the mesh's
-/// triangle count, a known method; closest feature maps consistent with the sphere-tree
+/// triangle count, a known method; the spheres bounding the mesh (the root contains every
+/// triangle corner; on every level, every triangle is listed and each corner of a listed
+/// triangle lies in some sphere of the level listing it; tolerance 1e-6 of the bounding-box
+/// diagonal; the error names the sphere and its level); closest feature maps consistent with the sphere-tree
 /// (ClosestFeatureMap::fromData); a contact tree passing decodeContactTree's checks, with no
 /// bytes after it, and belonging to the mesh (see BakeContents::contactTree). Other errors: kBakeTruncated, kBakeVersion (the file or a
 /// known section is newer than this build), kBakeMissingSection ('MESH' or 'STRE' absent).

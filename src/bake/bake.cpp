@@ -19,6 +19,7 @@
 #include "cfm_section.h"
 #include "contact_tree_section.h"
 #include "mesh_section.h"
+#include "sphere_tree_bounds_check.h"
 #include "sphere_tree_section.h"
 
 namespace clod {
@@ -41,6 +42,8 @@ std::vector<std::byte> encodeBake(const BakeContents& contents) {
   detail::checkMesh(contents.mesh, {ErrorCode::kInvalidArgument, "encodeBake: mesh"});
   detail::checkSphereTree(contents.sphereTree, contents.sphereTreeSettings, contents.mesh.triangleCount(),
                           {ErrorCode::kInvalidArgument, "encodeBake: sphere-tree"});
+  detail::checkSphereTreeBoundsMesh(contents.sphereTree, contents.mesh,
+                                    {ErrorCode::kInvalidArgument, "encodeBake: sphere-tree"});
   BakeFileWriter writer;
   writer.addSection(kBakeMeshTag, kBakeMeshVersion,
                     detail::encodeMeshSection(contents.mesh, meshContentHash(contents.mesh), contents.sourceName));
@@ -74,6 +77,7 @@ BakeContents decodeBake(std::span<const std::byte> bytes) {
     const BakeSection section = file.section(kBakeSphereTreeTag, kBakeSphereTreeVersion);
     detail::DecodedSphereTreeSection tree =
         detail::decodeSphereTreeSection(section.payload, contents.mesh.triangleCount(), section.version);
+    detail::checkSphereTreeBoundsMesh(tree.tree, contents.mesh, {ErrorCode::kBakeCorrupt, "bake section 'STRE'"});
     contents.sphereTree = std::move(tree.tree);
     contents.sphereTreeSettings = tree.settings;
   }
