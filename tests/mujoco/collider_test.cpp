@@ -203,9 +203,10 @@ void stepAt(const mjModel* m, mjData* d, int step) {
 
 TEST(MujocoCollider, InterruptedPairResumesFromItsFrontInTheNextStep) {
   // A sphere resting on the slab (the same pose every step). Oracle: the unlimited query's contacts
-  // at that pose. The step budget is the largest at which the first step is interrupted; the coherence cache keeps the front it reached, and the next step, re-testing
-  // that front (one test per pair) and refining it, finishes with the unlimited answer. Without
-  // the cache every step starts again from the roots below the cost and never finishes.
+  // at that pose. The step budget is the largest at which the first step is interrupted; the
+  // coherence cache keeps the front it reached, and the next step, re-testing that front (one test
+  // per pair) and refining it, finishes with the unlimited answer. Without the cache every step
+  // starts again from the roots below the cost and never finishes.
   // frontierPairCost 0: with the default charge of 2 units per front pair a resumed query needs
   // five units per pair of its final front (re-test, charge, and the charge reserved for each
   // test's growth), more than this pair's whole cold query costs: docs/engines-mujoco.md, limits.

@@ -393,7 +393,8 @@ TEST(BulletBudget, InterruptedPairResumesFromItsFrontInTheNextSubstep) {
                           (Vec3(p.normalBToA.x(), p.normalBToA.y(), p.normalBToA.z()) - c.normal).norm() < 1e-5 &&
                           (Vec3(p.onB.x(), p.onB.y(), p.onB.z()) - onSlab).norm() < 1e-5);
       }
-      EXPECT_TRUE(found) << "depth " << p.depth << " at (" << p.onB.x() << ", " << p.onB.y() << ", " << p.onB.z() << ")";
+      EXPECT_TRUE(found) << "depth " << p.depth << " at (" << p.onB.x() << ", " << p.onB.y() << ", "
+                         << p.onB.z() << ")";
     }
   }
 }
