@@ -4,6 +4,7 @@
 #if CLOD_HAVE_MUJOCO
 
 #include <cmath>
+#include <vector>
 
 #include "clod/error.h"
 #include "clod/primitives.h"
@@ -163,6 +164,209 @@ TEST(MujocoCollider, StepBudgetIsSharedAndNeverExceeded) {
     // Whatever the budget, the cubes rest on the slab (top at 0.2; cube centres at 0.6).
     for (int b = 1; b <= 4; ++b) EXPECT_NEAR(test::bodyPosition(d.get(), b).z(), 0.6, 0.02);
   }
+}
+
+// An icosphere (r 0.5) per body, sunk `sink` into a mesh slab whose top is at z 0, the bodies
+// 3 apart along x (so MuJoCo's broad phase pairs no two of them): one clod pair per sphere, each
+// touching the slab on a small cap.
+std::string spheresOnSlab(int spheres, double sink) {
+  std::string bodies;
+  for (int i = 0; i < spheres; ++i)
+    bodies += "<body name=\"s" + std::to_string(i) + "\" pos=\"" + std::to_string(3.0 * (i - 1)) + " 0 " +
+              std::to_string(0.5 - sink) + "\"><freejoint/><geom type=\"mesh\" mesh=\"ball\"/></body>";
+  return "<mujoco><asset>" + test::inlineMesh("ball", makeIcosphere(0.5, 3)) +
+         test::inlineMesh("slab", makeBox(Vec3(5, 2, 0.25))) +
+         "</asset><worldbody><geom type=\"mesh\" mesh=\"slab\" pos=\"0 0 -0.25\"/>" + bodies + "</worldbody></mujoco>";
+}
+
+// The contacts of one mj_forward, in MuJoCo's order.
+struct Seen {
+  int geom1, geom2;
+  Vec3 pos;
+  double dist;
+};
+std::vector<Seen> contactsOf(const mjData* d) {
+  std::vector<Seen> out;
+  for (int i = 0; i < d->ncon; ++i) {
+    const mjContact& c = d->contact[i];
+    out.push_back({c.geom1, c.geom2, Vec3(c.pos[0], c.pos[1], c.pos[2]), c.dist});
+  }
+  return out;
+}
+
+// One step at a fixed pose: the collider tells steps apart by mjData::time, so advancing the
+// clock and calling mj_forward is a step in which the bodies rest exactly where they were.
+void stepAt(const mjModel* m, mjData* d, int step) {
+  d->time = 0.001 * step;
+  mj_forward(m, d);
+}
+
+TEST(MujocoCollider, InterruptedPairResumesFromItsFrontInTheNextStep) {
+  // A sphere resting on the slab (the same pose every step). Oracle: the unlimited query's contacts
+  // at that pose. The step budget is the largest at which the first step is interrupted; the
+  // coherence cache keeps the front it reached, and the next step, re-testing that front (one test
+  // per pair) and refining it, finishes with the unlimited answer. Without the cache every step
+  // starts again from the roots below the cost and never finishes.
+  // frontierPairCost 0: with the default charge of 2 units per front pair a resumed query needs
+  // five units per pair of its final front (re-test, charge, and the charge reserved for each
+  // test's growth), more than this pair's whole cold query costs: docs/engines-mujoco.md, limits.
+  mujoco::ModelPtr m = test::loadXmlText(spheresOnSlab(1, 0.01), "resume.xml");
+  ColliderSettings settings;
+  settings.model = ContactModel::kCfm;
+  settings.frontierPairCost = 0;
+  // One step from a fresh state at `budget` tests (0 = unlimited): its contacts, and whether the
+  // query was interrupted.
+  auto firstStep = [&](std::uint64_t budget, std::vector<Seen>* contacts) {
+    ColliderSettings probe = settings;
+    probe.budgetTests = budget;
+    mujoco::DataPtr d(mj_makeData(m.get()));
+    Collider collider(probe);
+    collider.addModel(m.get());
+    collider.install();
+    stepAt(m.get(), d.get(), 0);
+    if (contacts) *contacts = contactsOf(d.get());
+    return std::pair(collider.totals(d.get()).pairsInterrupted > 0, collider.totals(d.get()).testsSpent);
+  };
+  std::vector<Seen> unlimited;
+  const auto [unlimitedInterrupted, cost] = firstStep(0, &unlimited);
+  ASSERT_FALSE(unlimitedInterrupted);
+  ASSERT_GE(unlimited.size(), 1u);
+  for (const Seen& c : unlimited) EXPECT_LT(c.dist, 0.0);
+  // The largest budget at which the first step is interrupted (a query stops before an expansion
+  // it cannot pay for whole, so this is up to one expansion below the cost).
+  std::uint64_t lo = 1, hi = cost;  // interrupted at lo (asserted below), finished at hi
+  while (hi - lo > 1) {
+    const std::uint64_t mid = (lo + hi) / 2;
+    (firstStep(mid, nullptr).first ? lo : hi) = mid;
+  }
+  ASSERT_TRUE(firstStep(lo, nullptr).first);
+  settings.budgetTests = lo;
+  SCOPED_TRACE("unlimited query: " + std::to_string(cost) + " tests, budget " + std::to_string(settings.budgetTests));
+  for (const bool coherence : {true, false}) {
+    SCOPED_TRACE(coherence ? "coherence" : "no coherence");
+    settings.coherence = coherence;
+    mujoco::DataPtr d(mj_makeData(m.get()));
+    Collider collider(settings);
+    collider.addModel(m.get());
+    collider.install();
+    int finishedAt = -1;
+    for (int step = 0; step < 20 && finishedAt < 0; ++step) {
+      stepAt(m.get(), d.get(), step);
+      if (collider.totals(d.get()).pairsInterrupted == std::uint32_t(step)) finishedAt = step;
+    }
+    if (!coherence) {
+      EXPECT_EQ(finishedAt, -1) << "a query restarted from the roots cannot finish below its cost";
+      continue;
+    }
+    EXPECT_EQ(finishedAt, 1) << "interrupted in the first step, finished from its front in the second";
+    const std::vector<Seen> resumed = contactsOf(d.get());
+    ASSERT_EQ(resumed.size(), unlimited.size());
+    for (std::size_t i = 0; i < resumed.size(); ++i) {
+      EXPECT_NEAR(resumed[i].dist, unlimited[i].dist, 1e-12);
+      EXPECT_NEAR((resumed[i].pos - unlimited[i].pos).norm(), 0.0, 1e-12);
+    }
+    EXPECT_LE(collider.totals(d.get()).testsSpent, 2 * settings.budgetTests);
+  }
+}
+
+TEST(MujocoCollider, SkippedPairReplaysItsContactsMovedWithTheGeoms) {
+  // Three spheres on the slab at a step budget that cannot query them all. Every step slides the
+  // spheres by dx along x. A pair the budget skips keeps its previous contacts anchored in both
+  // geoms (collider.h): the slab's point stays, the sphere's moves dx, so the contact point moves
+  // dx / 2 and the depth (along the slab's vertical normal) is unchanged -- whereas a new query
+  // puts the point under the sphere, dx further. So in each step exactly as many pairs as the
+  // collider reports skipped must show their previous contacts moved by dx / 2, none missing.
+  const int spheres = 3;
+  mujoco::ModelPtr m = test::loadXmlText(spheresOnSlab(spheres, 0.01), "replay.xml");
+  mujoco::DataPtr d(mj_makeData(m.get()));
+  ColliderSettings settings;
+  settings.model = ContactModel::kExact;
+  settings.budgetTests = 8;
+  Collider collider(settings);
+  collider.addModel(m.get());
+  collider.install();
+  const double dx = 1e-3;
+  std::vector<Seen> previous;
+  std::uint32_t skippedTotal = 0, skippedChecked = 0;
+  int checked = 0;
+  for (int step = 0; step < 30; ++step) {
+    for (int b = 0; b < spheres; ++b) d->qpos[7 * b] = 3.0 * (b - 1) + dx * step;
+    stepAt(m.get(), d.get(), step);
+    const std::vector<Seen> now = contactsOf(d.get());
+    const mujoco::StepStats s = collider.totals(d.get());
+    const std::uint32_t skipped = s.pairsSkipped - skippedTotal;
+    skippedTotal = s.pairsSkipped;
+    // Each sphere's contacts (its pair is (slab, sphere) in either order).
+    auto ofSphere = [&](const std::vector<Seen>& all, int b) {
+      std::vector<const Seen*> out;
+      for (const Seen& c : all)
+        if (m->geom_bodyid[c.geom1] == b + 1 || m->geom_bodyid[c.geom2] == b + 1) out.push_back(&c);
+      return out;
+    };
+    // From the step after every pair has been queried once (before that a skipped pair has
+    // nothing to replay) every sphere must have contacts in every step, queried or replayed.
+    bool allQueried = step > 0;
+    for (int b = 0; b < spheres; ++b) allQueried = allQueried && !ofSphere(previous, b).empty();
+    if (!allQueried) {
+      previous = now;
+      continue;
+    }
+    ++checked;
+    std::uint32_t replayed = 0;
+    for (int b = 0; b < spheres; ++b) {
+      const std::vector<const Seen*> before = ofSphere(previous, b), after = ofSphere(now, b);
+      EXPECT_FALSE(after.empty()) << "sphere " << b << ", step " << step;
+      bool moved = !before.empty() && before.size() == after.size();
+      for (std::size_t i = 0; moved && i < before.size(); ++i)
+        moved = std::abs(after[i]->dist - before[i]->dist) < 1e-9 &&
+                (after[i]->pos - before[i]->pos - Vec3(dx / 2, 0, 0)).norm() < 1e-9;
+      replayed += moved;
+    }
+    EXPECT_EQ(replayed, skipped) << "step " << step;
+    skippedChecked += skipped;
+    previous = now;
+  }
+  EXPECT_GE(checked, 20);
+  EXPECT_GE(skippedChecked, 20u) << "the budget must be too small for three pairs a step";
+  EXPECT_EQ(collider.totals(d.get()).pairsFallback, 0u) << collider.lastError();
+}
+
+TEST(MujocoCollider, ContactsPerPairAreCappedAtMjmaxconpair) {
+  // A bed of 8 x 8 separate square pillars (one mesh) sunk 0.01 into a slab: 64 disjoint contact
+  // patches, far more contacts than MuJoCo's per-pair array holds (mjMAXCONPAIR, 50).
+  TriangleMesh bed;
+  for (int i = 0; i < 8; ++i)
+    for (int j = 0; j < 8; ++j) {
+      TriangleMesh pillar = makeBox(Vec3(0.05, 0.05, 0.05));
+      const auto base = std::uint32_t(bed.vertices.size());
+      for (const Vec3& v : pillar.vertices) bed.vertices.push_back(v + Vec3(0.25 * i - 0.875, 0.25 * j - 0.875, 0));
+      for (const Triangle& t : pillar.triangles) bed.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+    }
+  const std::string xml = "<mujoco><asset>" + test::inlineMesh("bed", bed) +
+                          test::inlineMesh("slab", makeBox(Vec3(2, 2, 0.25))) +
+                          "</asset><worldbody><geom name=\"slab\" type=\"mesh\" mesh=\"slab\" pos=\"0 0 -0.25\"/>"
+                          "<body pos=\"0 0 0.04\"><freejoint/><geom name=\"bed\" type=\"mesh\" mesh=\"bed\"/></body>"
+                          "</worldbody></mujoco>";
+  mujoco::ModelPtr m = test::loadXmlText(xml, "bed.xml");
+  for (const std::uint32_t maxContacts : {8u, 50u}) {
+    SCOPED_TRACE("maxContacts " + std::to_string(maxContacts));
+    mujoco::DataPtr d(mj_makeData(m.get()));
+    ColliderSettings settings;
+    settings.model = ContactModel::kExact;
+    settings.maxContacts = maxContacts;
+    Collider collider(settings);
+    collider.addModel(m.get());
+    collider.install();
+    mj_forward(m.get(), d.get());
+    EXPECT_EQ(d->ncon, int(maxContacts));  // 64 patches, each deeper than MuJoCo's margin 0
+    for (int i = 0; i < d->ncon; ++i) {
+      EXPECT_LT(d->contact[i].dist, 0.0);
+      EXPECT_NEAR(d->contact[i].pos[2], -0.005, 0.005 + 1e-9);  // within the 1 cm overlap
+    }
+  }
+  EXPECT_EQ(mjMAXCONPAIR, 50);
+  EXPECT_THROW(Collider(ColliderSettings{.maxContacts = mjMAXCONPAIR + 1}), Error);
+  EXPECT_THROW(Collider(ColliderSettings{.maxContacts = 0}), Error);
 }
 
 TEST(MujocoCollider, BadModelFilesNameTheirError) {

@@ -20,6 +20,7 @@
 #include "clod/error.h"
 #include "clod/part_meshes.h"
 #include "clod/primitives.h"
+#include "clod/query.h"
 
 namespace {
 
@@ -329,6 +330,71 @@ TEST(BulletBudget, TimeBudgetSkipsThePairsReachedAfterIt) {
     } else {
       EXPECT_EQ(skipped, 0u);
       for (std::size_t i = 1; i < w.bodies.size(); ++i) EXPECT_GT(w.bodies[i]->getCenterOfMassPosition().z(), 0.45);
+    }
+  }
+}
+
+TEST(BulletBudget, InterruptedPairResumesFromItsFrontInTheNextSubstep) {
+  // A faceted ball (r 0.5) sunk 1 cm into a slab, at rest (a collision-only world: the same poses
+  // every dispatch). The budget is the largest at which one query is interrupted, so the first
+  // dispatch is. The pair's coherence cache keeps the front it reached, and the next
+  // dispatch, re-testing that front and refining it, must finish; a query restarted from the roots
+  // never could. Oracle for the finished manifold: clod's own unlimited answer at that pose,
+  // queried directly (each point Bullet keeps must be one of its contacts: Bullet reduces to 4).
+  const auto ballBody = bakeBody(clod::makeIcosphere(0.5, 3));
+  const auto slabBody = boxBody(Vec3(2, 2, 0.25));
+  auto ball = std::make_unique<MeshShape>(ballBody);
+  auto slab = std::make_unique<MeshShape>(slabBody);
+  const btTransform ballPose = pose(btVector3(0, 0, 0.49f)), slabPose = pose(btVector3(0, 0, -0.25f));
+  for (const auto model : {clod::ContactModel::kCfm, clod::ContactModel::kExact}) {
+    SCOPED_TRACE(model == clod::ContactModel::kCfm ? "cfm" : "exact");
+    clod::QuerySettings qs;
+    qs.model = model;
+    const clod::QueryResult oracle =
+        clod::queryContacts(*ballBody, clod::Pose{clod::Quat::Identity(), Vec3(0, 0, 0.49f)}, *slabBody,
+                            clod::Pose{clod::Quat::Identity(), Vec3(0, 0, -0.25)}, qs);
+    ASSERT_TRUE(oracle.finished);
+    ASSERT_FALSE(oracle.contacts.empty());
+    // The largest budget at which one query is interrupted (a query stops before an expansion it
+    // cannot pay for whole, so this is up to one expansion below the cost).
+    auto interrupted = [&](std::uint64_t tests) {
+      clod::QuerySettings limited = qs;
+      limited.budget = clod::QueryBudget::tests(tests);
+      return !clod::queryContacts(*ballBody, clod::Pose{clod::Quat::Identity(), Vec3(0, 0, 0.49f)}, *slabBody,
+                                  clod::Pose{clod::Quat::Identity(), Vec3(0, 0, -0.25)}, limited).finished;
+    };
+    std::uint64_t lo = 1, hi = oracle.tests;  // interrupted at lo (asserted below), finished at hi
+    while (hi - lo > 1) {
+      const std::uint64_t mid = (lo + hi) / 2;
+      (interrupted(mid) ? lo : hi) = mid;
+    }
+    ASSERT_TRUE(interrupted(lo));
+    const std::uint64_t budget = lo;
+    SCOPED_TRACE("unlimited query: " + std::to_string(oracle.tests) + " tests, budget " + std::to_string(budget));
+    PairWorld pw(ball.get(), ballPose, slab.get(), slabPose);
+    Collider collider({.model = model, .budgetTests = budget});
+    collider.install(pw.world);
+    std::vector<PairWorld::Point> points;
+    int finishedAt = -1;
+    for (int dispatch = 0; dispatch < 10 && finishedAt < 0; ++dispatch) {
+      points = pw.contacts();
+      const clod::bullet::DispatchReport& r = collider.lastDispatch();
+      ASSERT_EQ(r.queried, 1u);
+      EXPECT_LE(r.tests, budget);
+      if (r.interrupted == 0) finishedAt = dispatch;
+    }
+    EXPECT_EQ(finishedAt, 1) << "interrupted in the first dispatch, finished from its front in the second";
+    ASSERT_FALSE(points.empty());
+    for (const PairWorld::Point& p : points) {
+      bool found = false;
+      for (const clod::Contact& c : oracle.contacts) {
+        const Vec3 onSlab = c.point + 0.5 * c.depth * c.normal;  // clod's normal: slab (B) toward ball (A)
+        found = found || (std::abs(p.depth - c.depth) < 1e-5 &&
+                          (Vec3(p.normalBToA.x(), p.normalBToA.y(), p.normalBToA.z()) - c.normal).norm() < 1e-5 &&
+                          (Vec3(p.onB.x(), p.onB.y(), p.onB.z()) - onSlab).norm() < 1e-5);
+      }
+      EXPECT_TRUE(found) << "depth " << p.depth << " at (" << p.onB.x() << ", " << p.onB.y() << ", "
+                         << p.onB.z() << ")";
     }
   }
 }
