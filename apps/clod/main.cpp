@@ -1,6 +1,7 @@
 // clod command-line tool: dispatches to the registered subcommands (see command.h).
 #include <cstdio>
 #include <exception>
+#include <new>
 #include <iostream>
 #include <string>
 
@@ -62,6 +63,11 @@ int main(int argc, char** argv) {
   } catch (const clod::Error& e) {
     std::cerr << "clod: error [" << clod::errorCodeName(e.code()) << "]: " << e.what() << "\n";
     return e.code() == clod::ErrorCode::kInvalidArgument ? 2 : 1;
+  } catch (const std::bad_alloc&) {
+    // Limits that can be checked ahead are (README, "Limits"); what is left is the machine's.
+    std::cerr << "clod: error [" << clod::errorCodeName(clod::ErrorCode::kResourceLimit)
+              << "]: out of memory (std::bad_alloc); the input needs more memory than this machine gives\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "clod: error: " << e.what() << "\n";
     return 1;

@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -31,7 +32,11 @@ struct BroadPhaseScratch {
 /// pairs of two static bodies can be left out). Output sorted lexicographically, so it does not
 /// depend on the sweep axis. Empty boxes (Aabb::empty) overlap nothing. `active`, when given,
 /// has boxes.size() entries (CLOD_ASSERT). Throws nothing.
-void findOverlappingPairs(std::span<const Aabb> boxes, const std::uint8_t* active,
-                          std::vector<BodyPair>& pairs, BroadPhaseScratch& scratch);
+/// Stops and returns false once more than `maxPairs` pairs are found (then `pairs` holds
+/// maxPairs + 1 of them, unsorted): n bodies piled at one point make n(n-1)/2 pairs, and a
+/// caller with a memory limit learns it before the list grows to that size.
+bool findOverlappingPairs(std::span<const Aabb> boxes, const std::uint8_t* active,
+                          std::vector<BodyPair>& pairs, BroadPhaseScratch& scratch,
+                          std::size_t maxPairs = std::numeric_limits<std::size_t>::max());
 
 }  // namespace clod

@@ -35,6 +35,7 @@ enum class ErrorCode : std::uint16_t {
   kSceneError,            ///< a scene description is malformed (message holds the key path)
   kSimulationDiverged,    ///< a body's state became NaN/Inf (message names the body)
   kExternalToolFailed,    ///< a program we run (gnuplot) is missing or failed (message names it)
+  kResourceLimit,         ///< a documented, settable limit on work or memory was reached (message names it)
 };
 
 /// Short stable name of an error code, e.g. "non_finite_vertex".

@@ -11,6 +11,7 @@
 // "min_substep_iterations" (WorldSettings::minSubstepIterations, 0..20, default 4),
 // "frontier_pair_cost" (WorldSettings::frontierPairCost, 0..1024, default 2),
 // "rolling_resistance" (WorldSettings::rollingResistanceRel, 0..1, default 0.003),
+// "max_pairs", "max_cached_node_pairs" (WorldSettings's memory limits, defaults 2^20 and 2^23),
 // "bounds" {"min": [..], "max": [..]}, "bodies" [ ... ]. Body keys: "name", exactly one of
 // "mesh" (path relative to the scene file), "box" [hx,hy,hz] (half extents) or "sphere" r;
 // "position", "orientation" [w,x,y,z], "velocity", "angular_velocity", "torque" [x,y,z] (N m,

@@ -194,6 +194,15 @@ struct WorldSettings {
   /// x diagonal); its contacts follow the bodies through their anchors. 0 queries every pair in
   /// every substep (docs/dynamics.md, "Manifold reuse").
   double reuseMotionRel = 0.001;
+  /// Memory limits (README, "Limits on hostile input"). A step whose broad phase finds more
+  /// overlapping body pairs than maxPairs throws Error(kResourceLimit) before it allocates their
+  /// state (n bodies piled at one point make n(n-1)/2 pairs: 10,000 ended in std::bad_alloc).
+  std::uint64_t maxPairs = std::uint64_t{1} << 20;
+  /// The pairs' coherence caches (each query's front, carried to the next) hold at most this
+  /// many node pairs together (16 bytes each): a pair keeps its cache while it holds at most
+  /// an even share, maxCachedNodePairs / pairs; a larger one is dropped and the pair's next
+  /// query starts from the roots. Coincident meshes keep thousands of leaf pairs per pair.
+  std::uint64_t maxCachedNodePairs = std::uint64_t{1} << 23;
   /// Narrow-phase level cap for every pair (QuerySettings::maxLevel); default: no cap.
   std::uint32_t maxLevel = UINT32_MAX;
   /// At most this many substeps per step (>= 1).

@@ -524,7 +524,7 @@ void bindCore(py::module_& mod) {
     }
   });
   py::dict codes;
-  for (int c = static_cast<int>(ErrorCode::kInvalidArgument); c <= static_cast<int>(ErrorCode::kExternalToolFailed); ++c) {
+  for (int c = static_cast<int>(ErrorCode::kInvalidArgument); c <= static_cast<int>(ErrorCode::kResourceLimit); ++c) {
     codes[py::str(std::string(errorCodeName(static_cast<ErrorCode>(c))))] = c;
   }
   mod.attr("error_codes") = codes;

@@ -6,11 +6,11 @@
 
 namespace clod {
 
-void findOverlappingPairs(std::span<const Aabb> boxes, const std::uint8_t* active,
-                          std::vector<BodyPair>& pairs, BroadPhaseScratch& scratch) {
+bool findOverlappingPairs(std::span<const Aabb> boxes, const std::uint8_t* active,
+                          std::vector<BodyPair>& pairs, BroadPhaseScratch& scratch, std::size_t maxPairs) {
   pairs.clear();
   const std::size_t n = boxes.size();
-  if (n < 2) return;
+  if (n < 2) return true;
   // Sweep along the axis on which the centres spread most: fewest false overlaps there.
   Vec3 mean = Vec3::Zero();
   Vec3 meanSq = Vec3::Zero();
@@ -46,10 +46,13 @@ void findOverlappingPairs(std::span<const Aabb> boxes, const std::uint8_t* activ
       bool overlap = true;
       for (int k = 0; k < 3; ++k)
         if (a.min[k] > b.max[k] || b.min[k] > a.max[k]) overlap = false;
-      if (overlap) pairs.push_back({i, j});
+      if (!overlap) continue;
+      pairs.push_back({i, j});
+      if (pairs.size() > maxPairs) return false;
     }
   }
   std::sort(pairs.begin(), pairs.end());
+  return true;
 }
 
 }  // namespace clod

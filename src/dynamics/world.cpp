@@ -240,6 +240,19 @@ struct World::Impl {
   double microsPerUnit = 0.5;
   std::vector<double> stepTravel;
 
+  // The broad phase, refused past WorldSettings::maxPairs before the pairs' state is allocated.
+  void findPairsWithinLimit(const std::vector<Aabb>& bodyBoxes, const std::vector<std::uint8_t>& isActive,
+                            std::vector<BodyPair>& out) {
+    const std::uint64_t limit = settings.maxPairs;
+    if (!findOverlappingPairs(bodyBoxes, isActive.data(), out, bpScratch,
+                              static_cast<std::size_t>(std::min<std::uint64_t>(limit, SIZE_MAX)))) {
+      out.clear();
+      throw Error(ErrorCode::kResourceLimit, "the broad phase found more than " + std::to_string(limit) +
+                                                 " overlapping body pairs (WorldSettings::maxPairs, scene key "
+                                                 "\"max_pairs\"); are bodies piled at one point?");
+    }
+  }
+
   void validateSettings() const {
     const WorldSettings& s = settings;
     auto bad = [](const std::string& m) { throw Error(ErrorCode::kInvalidArgument, "world settings: " + m); };
@@ -258,6 +271,7 @@ struct World::Impl {
     if (s.frontierPairCost > 1024) bad("frontierPairCost must be in [0, 1024]");
     if (!(s.budgetMicros >= 0.0 && std::isfinite(s.budgetMicros))) bad("budgetMicros must be >= 0 and finite");
     if (s.clock == nullptr) bad("clock must not be null");
+    if (s.maxPairs == 0) bad("maxPairs must be >= 1");
   }
 
   // limited == false: unlimited budget; else at most `allowance` budget units this substep (0:
@@ -393,7 +407,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     boxes[i] = b.worldBox((b.v.norm() + reach) * h);
     active[i] = b.type == BodyType::kDynamic;
   }
-  findOverlappingPairs(boxes, active.data(), candidates, bpScratch);
+  findPairsWithinLimit(boxes, active, candidates);
   filterCandidates(candidates);
   report.candidatePairs += candidates.size();
 
@@ -416,6 +430,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
   });
   std::uint64_t remaining = allowance;
   std::size_t left = order.size();
+  const std::uint64_t cacheShare = std::max<std::uint64_t>(1, s.maxCachedNodePairs / std::max<std::size_t>(1, left));
   // The contact tree samples every cell pair of its answer frontier, cfm looks up both maps and
   // runs a separating-axis test per frontier sphere pair, and exact does the latter for the pairs
   // an interrupted query did not triangle-test: each frontier pair costs `perCell` budget units
@@ -598,6 +613,8 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       qs.model = s.model;
       p->cache.clear();  // a sphere front; the next contact-tree query starts from the roots
     }
+    // WorldSettings::maxCachedNodePairs: a new cache, not clear(), which would keep the memory.
+    if (p->cache.frontSize() > cacheShare) p->cache = CoherenceCache();
     // Charged as far as the substep has it left (only the roots' answer above may cost more).
     const std::uint64_t fullCost = result.tests + perCell * result.frontier.size();
     const std::uint64_t cost = limited ? std::min(remaining, fullCost) : fullCost;
@@ -1390,7 +1407,7 @@ const StepReport& World::step(double dt) {
     }
     m.boxes[i] = b.worldBox(m.stepTravel[i]);
   }
-  findOverlappingPairs(m.boxes, m.active.data(), m.candidates, m.bpScratch);
+  m.findPairsWithinLimit(m.boxes, m.active, m.candidates);
   m.filterCandidates(m.candidates);
   // Two rules, the larger wins: no body travels more than kTravelFraction of the thinnest
   // extent (no tunnelling), and two bodies that may touch this step travel together at most

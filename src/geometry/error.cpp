@@ -26,6 +26,7 @@ std::string_view errorCodeName(ErrorCode code) noexcept {
     case ErrorCode::kSceneError: return "scene_error";
     case ErrorCode::kSimulationDiverged: return "simulation_diverged";
     case ErrorCode::kExternalToolFailed: return "external_tool_failed";
+    case ErrorCode::kResourceLimit: return "resource_limit";
   }
   return "unknown_error";
 }

@@ -202,7 +202,8 @@ SceneDescription parseScene(std::string_view text, const std::filesystem::path& 
     throw Error(ErrorCode::kSceneError, fileName + ": not valid JSON: " + e.what());
   }
   r.object(j, "", {"gravity", "dt", "steps", "duration", "contact_model", "budget", "budget_us", "max_contacts", "min_substeps",
-                  "min_substep_iterations", "frontier_pair_cost", "rolling_resistance", "bounds", "bodies"});
+                  "min_substep_iterations", "frontier_pair_cost", "rolling_resistance", "max_pairs", "max_cached_node_pairs", "bounds",
+                  "bodies"});
   SceneDescription s;
   if (j.contains("gravity")) s.world.gravity = r.vec<3>(j["gravity"], "gravity");
   if (j.contains("dt")) s.dt = r.positive(j["dt"], "dt");
@@ -239,6 +240,9 @@ SceneDescription parseScene(std::string_view text, const std::filesystem::path& 
   }
   if (j.contains("frontier_pair_cost"))
     s.world.frontierPairCost = std::uint32_t(r.count(j["frontier_pair_cost"], "frontier_pair_cost", 0, 1024));
+  if (j.contains("max_pairs")) s.world.maxPairs = r.count(j["max_pairs"], "max_pairs", 1, std::uint64_t(1) << 40);
+  if (j.contains("max_cached_node_pairs"))
+    s.world.maxCachedNodePairs = r.count(j["max_cached_node_pairs"], "max_cached_node_pairs", 0, std::uint64_t(1) << 40);
   if (j.contains("bounds")) {
     r.object(j["bounds"], "bounds", {"min", "max"});
     if (!j["bounds"].contains("min") || !j["bounds"].contains("max")) r.fail("bounds", "needs \"min\" and \"max\"");

@@ -39,6 +39,26 @@ TEST(SweepAndPrune, FindsExactlyThePairsBruteForceFinds) {
   }
 }
 
+// The pair limit: a pile of n boxes at one point has n(n-1)/2 pairs (counted by brute force);
+// a limit of that many finds them all, one less stops early and says so.
+TEST(SweepAndPrune, StopsOnceMorePairsThanTheLimitAreFound) {
+  std::vector<Aabb> boxes(40);
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    boxes[i].min = Vec3(-1.0, -1.0, -1.0) + 0.01 * double(i) * Vec3::Ones();
+    boxes[i].max = boxes[i].min + Vec3(2.0, 2.0, 2.0);
+  }
+  std::size_t expected = 0;
+  for (std::size_t i = 0; i < boxes.size(); ++i)
+    for (std::size_t j = i + 1; j < boxes.size(); ++j) expected += overlapsBrute(boxes[i], boxes[j]);
+  ASSERT_EQ(expected, boxes.size() * (boxes.size() - 1) / 2);
+  std::vector<BodyPair> pairs;
+  BroadPhaseScratch scratch;
+  EXPECT_TRUE(findOverlappingPairs(boxes, nullptr, pairs, scratch, expected));
+  EXPECT_EQ(pairs.size(), expected);
+  EXPECT_FALSE(findOverlappingPairs(boxes, nullptr, pairs, scratch, expected - 1));
+  EXPECT_EQ(pairs.size(), expected);  // it stopped at the first pair past the limit
+}
+
 TEST(SweepAndPrune, TouchingBoxesCountAsOverlapping) {
   std::vector<Aabb> boxes(2);
   boxes[0].min = Vec3(0, 0, 0);

@@ -49,5 +49,73 @@ TEST(WorldAccessors, IdOutOfRangeThrowsNamingTheIdAndTheBodyCount) {
   EXPECT_EQ(accessorError([] { World().state(0); }), "World::state: body id 0 out of range (the world has 0 bodies)");
 }
 
+std::shared_ptr<const CollisionBody> sphereBody() {
+  BakeSettings settings;
+  settings.sphereTree.method = SphereTreeMethod::kOctree;
+  settings.sphereTree.depth = 3;
+  settings.measureFit = false;
+  settings.buildContactTree = false;
+  return std::make_shared<const CollisionBody>(
+      CollisionBody::fromBake(bakeMesh(makeIcosphere(0.1, 2), settings).contents));
+}
+
+// Memory limits (WorldSettings::maxPairs): n bodies piled at one point, far above anything else,
+// make exactly n(n-1)/2 pairs; a limit of that many steps, one less is a resource_limit error
+// naming the setting, thrown before the pairs' state exists (the world still steps afterwards
+// with a larger limit... it is a limit, not corruption).
+TEST(WorldLimits, MorePairsThanMaxPairsIsAResourceLimitError) {
+  const auto sphere = sphereBody();
+  constexpr int kBodies = 12;
+  for (std::uint64_t maxPairs : {std::uint64_t{kBodies * (kBodies - 1) / 2}, std::uint64_t{kBodies * (kBodies - 1) / 2 - 1}}) {
+    WorldSettings ws;
+    ws.model = ContactModel::kCfm;
+    ws.maxPairs = maxPairs;
+    World world(ws);
+    for (int i = 0; i < kBodies; ++i) {
+      RigidBodyDesc d;
+      d.shape = sphere;
+      d.position = Vec3(0.0, 0.0, 5.0);
+      world.addBody(d);
+    }
+    std::string error = "no error";
+    try {
+      world.step(1.0 / 60.0);
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kResourceLimit);
+      error = e.what();
+    }
+    if (maxPairs == kBodies * (kBodies - 1) / 2) {
+      EXPECT_EQ(error, "no error");
+    } else {
+      EXPECT_NE(error.find("WorldSettings::maxPairs"), std::string::npos) << error;
+    }
+  }
+}
+
+// WorldSettings::maxCachedNodePairs drops the coherence caches of coincident bodies (thousands
+// of leaf pairs each). At an unlimited budget a query's answer does not depend on its cache (it
+// finishes from the roots or from the cache at the same leaves), so a world that keeps no cache
+// steps exactly as one that keeps them all.
+TEST(WorldLimits, DroppingTheCoherenceCachesLeavesUnlimitedStepsUnchanged) {
+  const auto sphere = sphereBody();
+  std::vector<Vec3> end[2];
+  for (int run = 0; run < 2; ++run) {
+    WorldSettings ws;
+    ws.model = ContactModel::kExact;
+    ws.maxCachedNodePairs = run == 0 ? std::uint64_t{1} << 40 : 0;
+    ws.reuseMotionRel = 0.0;  // query every substep, so the caches would be used
+    World world(ws);
+    for (int i = 0; i < 4; ++i) {
+      RigidBodyDesc d;
+      d.shape = sphere;
+      d.position = Vec3(0.01 * i, 0.0, 5.0);
+      world.addBody(d);
+    }
+    for (int k = 0; k < 5; ++k) world.step(1.0 / 60.0);
+    for (BodyId id = 0; id < world.bodyCount(); ++id) end[run].push_back(world.state(id).position);
+  }
+  for (std::size_t i = 0; i < end[0].size(); ++i) EXPECT_EQ(end[0][i], end[1][i]) << "body " << i;
+}
+
 }  // namespace
 }  // namespace clod

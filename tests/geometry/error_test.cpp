@@ -9,7 +9,7 @@ namespace {
 
 TEST(ErrorCodes, EveryCodeHasAStableDistinctName) {
   std::set<std::string_view> names;
-  for (int code = 1; code <= static_cast<int>(clod::ErrorCode::kExternalToolFailed); ++code) {
+  for (int code = 1; code <= static_cast<int>(clod::ErrorCode::kResourceLimit); ++code) {
     auto name = clod::errorCodeName(static_cast<clod::ErrorCode>(code));
     EXPECT_NE(name, "unknown_error") << "code " << code;
     EXPECT_TRUE(names.insert(name).second) << "duplicate name " << name;

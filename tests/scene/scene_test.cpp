@@ -48,6 +48,8 @@ TEST(SceneParse, OutOfRangeAndConflictingValuesAreErrors) {
   EXPECT_NE(sceneError(R"({"bodies": [], "budget_us": "fast"})").find("budget_us"), std::string::npos);
   EXPECT_NE(sceneError(R"({"bodies": [], "min_substep_iterations": 21})").find("min_substep_iterations"),
             std::string::npos);
+  EXPECT_NE(sceneError(R"({"bodies": [], "max_pairs": 0})").find("max_pairs"), std::string::npos);
+  EXPECT_NE(sceneError(R"({"bodies": [], "max_cached_node_pairs": -1})").find("max_cached_node_pairs"), std::string::npos);
   EXPECT_NE(sceneError("{not json").find("not valid JSON"), std::string::npos);
   EXPECT_NE(sceneError(R"({"dt": 0.01})").find("bodies: missing"), std::string::npos);
 }
@@ -55,7 +57,7 @@ TEST(SceneParse, OutOfRangeAndConflictingValuesAreErrors) {
 TEST(SceneParse, ReadsEveryFieldAsWritten) {
   const SceneDescription s = parseScene(R"({"gravity": [0, 0, -1], "dt": 0.01, "duration": 0.5,
       "contact_model": "exact", "budget": 64, "budget_us": 1500, "max_contacts": 4, "min_substeps": 3,
-      "min_substep_iterations": 7, "frontier_pair_cost": 5,
+      "min_substep_iterations": 7, "frontier_pair_cost": 5, "max_pairs": 1000, "max_cached_node_pairs": 0,
       "bodies": [{"name": "a", "box": [1, 2, 3], "static": true},
                  {"name": "b", "sphere": 0.25, "position": [1, 2, 3], "orientation": [0, 0, 0, 2],
                   "velocity": [4, 5, 6], "angular_velocity": [7, 8, 9], "torque": [1, -2, 3], "mass": 3, "restitution": 0.5,
@@ -71,6 +73,8 @@ TEST(SceneParse, ReadsEveryFieldAsWritten) {
   EXPECT_EQ(s.world.minSubsteps, 3u);
   EXPECT_EQ(s.world.minSubstepIterations, 7u);
   EXPECT_EQ(s.world.frontierPairCost, 5u);
+  EXPECT_EQ(s.world.maxPairs, 1000u);
+  EXPECT_EQ(s.world.maxCachedNodePairs, 0u);
   ASSERT_EQ(s.bodies.size(), 3u);
   EXPECT_EQ(s.bodies[0].type, BodyType::kStatic);
   EXPECT_EQ(s.bodies[0].halfExtents, Vec3(1, 2, 3));
