@@ -52,6 +52,7 @@ struct BakeOptions {
   double sdfError = ContactTreeSettings{}.errorRel;
   std::uint32_t sdfDepth = ContactTreeSettings{}.maxDepth;
   bool noSdf = false;
+  std::uint64_t maxMemoryMb = BakeSettings{}.maxMemoryBytes >> 20;  // --max-memory-mb, 0: no limit
   bool json = false;
 };
 
@@ -81,6 +82,7 @@ int runBake(const BakeOptions& options) {
   settings.buildContactTree = !options.noSdf;
   settings.contactTree.errorRel = options.sdfError;
   settings.contactTree.maxDepth = options.sdfDepth;
+  settings.maxMemoryBytes = options.maxMemoryMb << 20;
 
   LoadedMesh loaded = loadMesh(options.meshPath);
   const BakeResult result = bakeMesh(loaded.mesh, settings);
@@ -241,6 +243,10 @@ const CommandRegistration kRegistration("bake", [](CLI::App& app) {
       ->check(CLI::Range(1, 20))
       ->capture_default_str();
   sub->add_flag("--no-sdf", options->noSdf, "Do not build the contact tree (no 'CTRE' section)");
+  sub->add_option("--max-memory-mb", options->maxMemoryMb,
+                  "Memory the bake may use, in MiB (0: no limit); past it: error [resource_limit]")
+      ->check(CLI::Range(std::uint64_t{0}, std::uint64_t{1} << 40))
+      ->capture_default_str();
   sub->add_flag("--json", options->json,
                 "Print one JSON object: levels[{level, spheres, fit_mean, fit_max}] (fit in units of the "
                 "bbox diagonal), build_seconds, file_bytes, mesh_hash, vertices, triangles, sign_method, "

@@ -37,6 +37,11 @@ struct ContactTreeSettings {
   /// refinement can reach eps_s; such cells are refined only while their diagonal exceeds
   /// discontinuityStopRel * diagonal, and keep their (large, measured) error bound.
   double discontinuityStopRel = 0.004;
+  /// At most this many nodes (0: no limit). The builder checks it before it adds each cell's
+  /// children and throws Error(kResourceLimit) naming it; building takes ~175 bytes per node at
+  /// its peak (measured on bunny-1500 at 0.4-3.5 M nodes). bakeMesh derives it from
+  /// BakeSettings::maxMemoryBytes.
+  std::uint64_t maxNodes = 0;
 };
 
 /// What the builder did; for logs, tests and benchmarks.

@@ -370,6 +370,13 @@ ContactTree Builder::build(ContactTreeBuildStats* stats) {
       }
       const std::size_t firstChild = tree_.levelOffsets.back() + frontier.size() + next.size();
       if (firstChild + 8 > 0xfffffff0u) throw Error(ErrorCode::kUnsupportedMesh, "contact tree: more than 2^32 nodes; raise errorRel or lower maxDepth");
+      if (settings_.maxNodes > 0 && firstChild + 8 > settings_.maxNodes) {
+        throw Error(ErrorCode::kResourceLimit,
+                    "contact tree: more than " + std::to_string(settings_.maxNodes) + " nodes at depth " +
+                        std::to_string(depth + 1) +
+                        " (ContactTreeSettings::maxNodes, from BakeSettings::maxMemoryBytes; clod bake "
+                        "--max-memory-mb); raise it, or raise the error bound (--sdf-error) or lower the depth (--sdf-depth)");
+      }
       for (int l = 0; l < kLatticeSize; ++l)
         if (kLatticeSlot[l] >= 0) tree_.lattice.push_back(r.lattice[l]);
       for (int o = 0; o < 8; ++o) {

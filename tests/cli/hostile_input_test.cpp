@@ -54,6 +54,25 @@ TEST_F(HostileInput, DeeplyNestedGltfIsAParseErrorInEveryCommand) {
   EXPECT_FALSE(fs::exists(dir_ / "deep.clod"));
 }
 
+// Memory limits: a bake past --max-memory-mb and a pile of bodies past the world's pair limit
+// end in resource_limit naming the setting, and leave no output behind.
+TEST_F(HostileInput, BakesAndWorldsPastTheirMemoryLimitsAreResourceLimitErrors) {
+  const fs::path mesh = dir_ / "box.obj";
+  std::ofstream(mesh) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  // 4 triangles x 1.5 kB fit in 1 MiB; the contact tree's ~190-byte nodes at 1e-5 do not.
+  expectError(runCli("bake " + quoted(mesh) + " -o " + quoted(dir_ / "t.clod") + " --sdf-error 1e-5 --max-memory-mb 1"), 1,
+              "resource_limit", "maxNodes");
+  EXPECT_FALSE(fs::exists(dir_ / "t.clod"));
+  std::ofstream scene(dir_ / "pile.json");
+  scene << R"({"steps": 1, "max_pairs": 44, "bodies": [)";  // 10 spheres at one point: 45 pairs
+  for (int i = 0; i < 10; ++i) scene << (i ? "," : "") << R"({"sphere": 0.1, "position": [0, 0, 5]})";
+  scene << "]}";
+  scene.close();
+  expectError(runCli("simulate " + quoted(dir_ / "pile.json") + " -o " + quoted(dir_ / "out")), 1, "resource_limit",
+              "WorldSettings::maxPairs");
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "trajectory.csv"));
+}
+
 TEST_F(HostileInput, NegativeOrTooLargeBudgetsAndDeadlinesAreUsageErrors) {
   // Usage is checked before any file is read, so the bake files need not exist.
   const std::string query = "query " + quoted(dir_ / "a.clod") + " " + quoted(dir_ / "b.clod");
