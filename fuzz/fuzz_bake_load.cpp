@@ -30,7 +30,7 @@ const clod::BakeContents& referenceContents() {
     t.centerX = {0.5, 0.25, 0.75};
     t.centerY = {0.5, 0.25, 0.5};
     t.centerZ = {0.5, 0.25, 0.5};
-    t.radius = {1.0, 0.8, 0.8};
+    t.radius = {1.0, 0.9, 1.1};  // each sphere holds every corner of the triangles it lists
     t.parent = {clod::kNoSphere, 0, 0};
     t.firstChild = {1, 0, 0};
     t.childCount = {2, 0, 0};
