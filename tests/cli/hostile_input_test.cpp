@@ -73,6 +73,14 @@ TEST_F(HostileInput, BakesAndWorldsPastTheirMemoryLimitsAreResourceLimitErrors) 
   EXPECT_FALSE(fs::exists(dir_ / "out" / "trajectory.csv"));
 }
 
+// A pose that is not finite (or not a rotation) gave `colliding` with NaN contacts.
+TEST_F(HostileInput, NonFinitePosesAreUsageErrors) {
+  const std::string query = "query " + quoted(dir_ / "a.clod") + " " + quoted(dir_ / "b.clod");
+  expectError(runCli(query + " --pose-a \"nan 0 0 1 0 0 0\""), 2, "invalid_argument", "--pose-a");
+  expectError(runCli(query + " --pose-b \"0 0 0 inf 0 0 0\""), 2, "invalid_argument", "--pose-b");
+  expectError(runCli(query + " --pose-b \"0 0 0 0 0 0 0\""), 2, "invalid_argument", "--pose-b");
+}
+
 TEST_F(HostileInput, NegativeOrTooLargeBudgetsAndDeadlinesAreUsageErrors) {
   // Usage is checked before any file is read, so the bake files need not exist.
   const std::string query = "query " + quoted(dir_ / "a.clod") + " " + quoted(dir_ / "b.clod");

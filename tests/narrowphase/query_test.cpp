@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <utility>
 #include <random>
 #include <string>
 #include <vector>
@@ -249,6 +251,28 @@ TEST(NarrowPhaseSpheres, SeparatedSpheresDoNotCollide) {
     EXPECT_FALSE(r.colliding) << contactModelName(model);
     EXPECT_TRUE(r.contacts.empty());
     EXPECT_TRUE(r.finished);
+  }
+}
+
+// A NaN or infinite pose, or a zero quaternion, would answer "colliding" with NaN contacts: every
+// model refuses it with kInvalidArgument instead.
+TEST(NarrowPhaseSpheres, NonFinitePosesAreRefusedByEveryModel) {
+  const Bodies& b = bodies();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::pair<Pose, Pose>> bad(3);
+  bad[0].first.translation = Vec3(nan, 0.0, 0.0);
+  bad[1].second.rotation = Quat(std::numeric_limits<double>::infinity(), 0.0, 0.0, 0.0);
+  bad[2].second.rotation = Quat(0.0, 0.0, 0.0, 0.0);
+  for (ContactModel model : allContactModels()) {
+    for (const auto& [poseA, poseB] : bad) {
+      ErrorCode code{};
+      try {
+        queryContacts(b.sphereA, poseA, b.sphereB, poseB, settingsFor(model, kUnlimitedTests));
+      } catch (const Error& e) {
+        code = e.code();
+      }
+      EXPECT_EQ(code, ErrorCode::kInvalidArgument) << contactModelName(model);
+    }
   }
 }
 
