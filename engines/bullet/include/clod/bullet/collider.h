@@ -38,7 +38,7 @@
 // Manifolds. A query that finished (reached the leaves) replaces the pair's manifold: its contacts
 // are added through btManifoldResult::addContactPoint, which matches each to a cached point (so
 // the cached point keeps its applied impulse for warm starting, and btPersistentManifold keeps at
-// most 4 points: the deepest and the largest area of the up to ColliderSettings::maxContacts given),
+// most 4 points: the deepest and the largest area of the ColliderSettings::maxContacts given),
 // and the cached points not matched are removed. An interrupted query's contacts are merged into
 // the manifold the same way but do not remove the points it did not find (those are finer ones from
 // earlier queries, which Bullet's refresh drops when they open or slide).
@@ -129,8 +129,11 @@ struct ColliderSettings {
   /// Narrow-phase wall-clock time per substep for all clod pairs together, microseconds; 0 = no
   /// time limit (finite, >= 0). With both set, each query gets both limits.
   double budgetMicros = 0.0;
-  /// clod's manifold size per query (QuerySettings::maxContacts, >= 1); Bullet keeps at most 4.
-  std::uint32_t maxContacts = 8;
+  /// clod's manifold size per query (QuerySettings::maxContacts, >= 1). Bullet keeps at most 4,
+  /// so 4 lets clod's reduction choose them (the deepest, the largest area) the same way every
+  /// substep; given 8, Bullet's choice among them changed from substep to substep and a twisted
+  /// stack drifted 21.5 mm in 10 s instead of 9.3 (docs/engines.md, "Manifolds").
+  std::uint32_t maxContacts = 4;
   /// Also collide MeshShape with btBoxShape through clod (the box baked once per distinct size,
   /// as a 12-triangle mesh, on first contact: it allocates then). false: Bullet's
   /// convex-vs-concave algorithm against the MeshShape's triangles.
