@@ -5,6 +5,8 @@
 #include <iostream>
 #include <sstream>
 
+#include <CLI/CLI.hpp>
+
 #include "clod/error.h"
 
 namespace clod::cli {
@@ -45,6 +47,19 @@ std::string csvField(std::string_view text) {
   }
   quoted += '"';
   return quoted;
+}
+
+void addMeshLimitOptions(CLI::App* sub, MeshLoadOptions* limits) {
+  const auto range = CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 40);
+  sub->add_option("--max-vertices", limits->maxVertices, "Refuse a mesh file with more vertices (before welding)")
+      ->check(range)
+      ->capture_default_str();
+  sub->add_option("--max-triangles", limits->maxTriangles, "Refuse a mesh file with more triangles")
+      ->check(range)
+      ->capture_default_str();
+  sub->add_option("--max-polygon-vertices", limits->maxPolygonVertices, "Refuse a mesh file with a polygon of more corners")
+      ->check(range)
+      ->capture_default_str();
 }
 
 }  // namespace clod::cli

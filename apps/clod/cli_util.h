@@ -8,8 +8,17 @@
 #include <nlohmann/json.hpp>
 
 #include "clod/math.h"
+#include "clod/mesh_io.h"
+
+namespace CLI {
+class App;
+}
 
 namespace clod::cli {
+
+/// --max-vertices, --max-triangles, --max-polygon-vertices: the mesh loader's resource limits
+/// (MeshLoadOptions), written into `limits` when given; for every command that loads a mesh file.
+void addMeshLimitOptions(CLI::App* sub, MeshLoadOptions* limits);
 
 inline nlohmann::json toJson(const Vec3& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
 

@@ -53,6 +53,7 @@ struct BakeOptions {
   std::uint32_t sdfDepth = ContactTreeSettings{}.maxDepth;
   bool noSdf = false;
   std::uint64_t maxMemoryMb = BakeSettings{}.maxMemoryBytes >> 20;  // --max-memory-mb, 0: no limit
+  MeshLoadOptions limits;  // --max-vertices, --max-triangles, --max-polygon-vertices
   bool json = false;
 };
 
@@ -84,7 +85,7 @@ int runBake(const BakeOptions& options) {
   settings.contactTree.maxDepth = options.sdfDepth;
   settings.maxMemoryBytes = options.maxMemoryMb << 20;
 
-  LoadedMesh loaded = loadMesh(options.meshPath);
+  LoadedMesh loaded = loadMesh(options.meshPath, options.limits);
   const BakeResult result = bakeMesh(loaded.mesh, settings);
 
   const auto writeStart = std::chrono::steady_clock::now();
@@ -247,6 +248,7 @@ const CommandRegistration kRegistration("bake", [](CLI::App& app) {
                   "Memory the bake may use, in MiB (0: no limit); past it: error [resource_limit]")
       ->check(CLI::Range(std::uint64_t{0}, std::uint64_t{1} << 40))
       ->capture_default_str();
+  addMeshLimitOptions(sub, &options->limits);
   sub->add_flag("--json", options->json,
                 "Print one JSON object: levels[{level, spheres, fit_mean, fit_max}] (fit in units of the "
                 "bbox diagonal), build_seconds, file_bytes, mesh_hash, vertices, triangles, sign_method, "

@@ -34,12 +34,13 @@ struct ClosestOptions {
   std::string pointsPath;
   bool json = false;
   bool forceWindingNumber = false;
+  MeshLoadOptions limits;  // --max-vertices, --max-triangles, --max-polygon-vertices
 };
 
 int runClosest(const ClosestOptions& options) {
   // Points first: a bad points file is reported without paying for the mesh.
   const std::vector<Vec3> points = readPointsFile(options.pointsPath);
-  LoadedMesh loaded = loadMesh(options.meshPath);
+  LoadedMesh loaded = loadMesh(options.meshPath, options.limits);
   MeshDistanceSettings settings;
   settings.forceWindingNumber = options.forceWindingNumber;
   const MeshDistance distance(std::move(loaded.mesh), settings);
@@ -94,6 +95,7 @@ const CommandRegistration kRegistration("closest", [](CLI::App& app) {
                 "index}, normal, sign_method");
   sub->add_flag("--winding-number", options->forceWindingNumber,
                 "Take the sign from the generalized winding number even for closed meshes");
+  addMeshLimitOptions(sub, &options->limits);
   return [options] { return runClosest(*options); };
 });
 

@@ -26,6 +26,7 @@ struct InspectOptions {
   bool json = false;
   double weldToleranceRel = MeshLoadOptions{}.weldToleranceRel;
   bool keepOrientation = false;
+  MeshLoadOptions limits;  // --max-vertices, --max-triangles, --max-polygon-vertices
 };
 
 nlohmann::json toJson(const Mat3& m) {
@@ -37,7 +38,7 @@ nlohmann::json toJson(const Mat3& m) {
 int runInspect(const InspectOptions& options) {
   if (!std::isfinite(options.weldToleranceRel))
     throw Error(ErrorCode::kInvalidArgument, "--weld-tolerance must be a finite number");
-  MeshLoadOptions loadOptions;
+  MeshLoadOptions loadOptions = options.limits;
   loadOptions.weldToleranceRel = options.weldToleranceRel;
   loadOptions.orientOutward = !options.keepOrientation;
   LoadedMesh loaded = loadMesh(options.path, loadOptions);
@@ -122,6 +123,7 @@ const CommandRegistration kRegistration("inspect", [](CLI::App& app) {
                   "negative: no welding)")
       ->capture_default_str();
   sub->add_flag("--keep-orientation", options->keepOrientation, "Do not flip an inside-out closed mesh");
+  addMeshLimitOptions(sub, &options->limits);
   return [options] { return runInspect(*options); };
 });
 

@@ -110,12 +110,28 @@ void checkPlyCounts(std::string_view text, const std::string& source, const Mesh
 
 }  // namespace
 
+namespace {
+// The command-line flag of a MeshLoadOptions limit: maxPolygonVertices -> max-polygon-vertices.
+std::string flagName(std::string_view option) {
+  std::string flag;
+  for (char c : option) {
+    if (c >= 'A' && c <= 'Z') {
+      flag += '-';
+      flag += static_cast<char>(c - 'A' + 'a');
+    } else {
+      flag += c;
+    }
+  }
+  return flag;
+}
+}  // namespace
+
 void enforceLimit(std::uint64_t count, std::uint64_t limit, std::string_view option, std::string_view what,
                   const std::string& where) {
   if (count <= limit) return;
   throw Error(ErrorCode::kUnsupportedMesh, where + ": " + std::to_string(count) + " " + std::string(what) +
                                                ", more than MeshLoadOptions::" + std::string(option) + " = " +
-                                               std::to_string(limit) + " (raise it to load this file)");
+                                               std::to_string(limit) + " (raise it to load this file: clod's --" + flagName(option) + ")");
 }
 
 void checkDeclaredCounts(std::string_view text, std::string_view format, const std::string& source,

@@ -63,6 +63,11 @@ TEST_F(HostileInput, BakesAndWorldsPastTheirMemoryLimitsAreResourceLimitErrors) 
   expectError(runCli("bake " + quoted(mesh) + " -o " + quoted(dir_ / "t.clod") + " --sdf-error 1e-5 --max-memory-mb 1"), 1,
               "resource_limit", "maxNodes");
   EXPECT_FALSE(fs::exists(dir_ / "t.clod"));
+  // The loader's limits are flags of every command that reads a mesh file.
+  expectError(runCli("inspect " + quoted(mesh) + " --max-triangles 3"), 1, "unsupported_mesh", "--max-triangles");
+  expectError(runCli("bake " + quoted(mesh) + " -o " + quoted(dir_ / "t.clod") + " --max-vertices 3"), 1, "unsupported_mesh",
+              "--max-vertices");
+  EXPECT_EQ(runCli("inspect " + quoted(mesh) + " --max-triangles 4").exitCode, 0);
   std::ofstream scene(dir_ / "pile.json");
   scene << R"({"steps": 1, "max_pairs": 44, "bodies": [)";  // 10 spheres at one point: 45 pairs
   for (int i = 0; i < 10; ++i) scene << (i ? "," : "") << R"({"sphere": 0.1, "position": [0, 0, 5]})";
