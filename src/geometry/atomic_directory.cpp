@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "clod/error.h"
+#include "file_type_name.h"
 
 namespace clod {
 namespace {
@@ -19,17 +20,6 @@ namespace fs = std::filesystem;
 
 [[noreturn]] void fail(const fs::path& path, const std::string& what) {
   throw Error(ErrorCode::kFileWriteFailed, "'" + path.string() + "': " + what);
-}
-
-const char* fileTypeName(fs::file_type type) {
-  switch (type) {
-    case fs::file_type::regular: return "a regular file";
-    case fs::file_type::character: return "a character device";
-    case fs::file_type::block: return "a block device";
-    case fs::file_type::fifo: return "a named pipe";
-    case fs::file_type::socket: return "a socket";
-    default: return "of another kind";
-  }
 }
 
 // fsync of a directory makes the names in it (the staging files, the exchange) durable.
@@ -83,7 +73,7 @@ void checkOutputDirectory(const fs::path& dir) {
   std::error_code ec;
   const fs::file_status status = fs::status(dir, ec);
   if (fs::exists(status) && !fs::is_directory(status)) {
-    fail(dir, std::string("refusing to use it as the output directory: it is ") + fileTypeName(status.type()) +
+    fail(dir, std::string("refusing to use it as the output directory: it is ") + detail::fileTypeName(status.type()) +
                   ", not a directory");
   }
 }

@@ -7,23 +7,9 @@
 #include <unistd.h>
 
 #include "clod/error.h"
+#include "file_type_name.h"
 
 namespace clod {
-
-namespace {
-
-const char* fileTypeName(std::filesystem::file_type type) {
-  switch (type) {
-    case std::filesystem::file_type::directory: return "a directory";
-    case std::filesystem::file_type::character: return "a character device";
-    case std::filesystem::file_type::block: return "a block device";
-    case std::filesystem::file_type::fifo: return "a named pipe";
-    case std::filesystem::file_type::socket: return "a socket";
-    default: return "of another kind";
-  }
-}
-
-}  // namespace
 
 void writeFileAtomically(const std::filesystem::path& path, std::string_view content) {
   // The rename would replace whatever is at `path`: as root, `-o /dev/full` turned the device
@@ -32,7 +18,7 @@ void writeFileAtomically(const std::filesystem::path& path, std::string_view con
   const auto status = std::filesystem::status(path, statusError);
   if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
     throw Error(ErrorCode::kFileWriteFailed, "refusing to replace '" + path.string() + "': it is " +
-                                                 fileTypeName(status.type()) + ", not a regular file");
+                                                 detail::fileTypeName(status.type()) + ", not a regular file");
   }
   // A temporary name of its own per call: two threads writing the same target (parallel scene
   // builds sharing a bake cache) each rename their own complete file into place.

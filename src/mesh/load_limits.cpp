@@ -108,9 +108,6 @@ void checkPlyCounts(std::string_view text, const std::string& source, const Mesh
   });
 }
 
-}  // namespace
-
-namespace {
 // The command-line flag of a MeshLoadOptions limit: maxPolygonVertices -> max-polygon-vertices.
 std::string flagName(std::string_view option) {
   std::string flag;
@@ -124,6 +121,7 @@ std::string flagName(std::string_view option) {
   }
   return flag;
 }
+
 }  // namespace
 
 void enforceLimit(std::uint64_t count, std::uint64_t limit, std::string_view option, std::string_view what,

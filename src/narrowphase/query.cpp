@@ -458,8 +458,6 @@ public:
     }
   }
 
-  // Rounds of expansion until every pair is final or the budget is out. Returns true when
-  // finished. `front` holds the answer frontier afterwards.
   // Deepest pairs first, ties by index: the order a budget cuts the rounds in, and the answer's.
   static void sortByPriority(std::vector<Pair>& pairs) {
     std::sort(pairs.begin(), pairs.end(), [](const Pair& x, const Pair& y) {
@@ -469,6 +467,8 @@ public:
     });
   }
 
+  // Rounds of expansion until every pair is final or the budget is out. Returns true when
+  // finished. `front` holds the answer frontier afterwards.
   bool refine(std::vector<Pair>& front, std::vector<Pair>& next, std::vector<Pair>* separated) {
     // Without a budget every round expands every pair whatever the order, so only the final
     // front is sorted (the same pairs in the same order; the sort per round was ~8 % of cfm's
@@ -644,13 +644,6 @@ struct Extent {
   double lo, hi;
 };
 
-// One side of a sphere pair as a support function in A's frame: the faceted patch of the sphere
-// (its vertices, CollisionBody::spherePatchVertices) when it has one, else the sphere itself,
-// which bounds whatever surface the sphere is responsible for. Both are conservative: they
-// contain that surface, so an axis along which two sides do not overlap proves that the two
-// spheres' triangles do not meet.
-// A curved patch is bounded twice: by its sphere, and by its support vertices
-// (CollisionBody::sphereSupportVertices) plus their slack; the smaller of the two supports holds.
 // A side's patch or support vertices in A's frame, as three flat arrays: the separating-axis
 // choice projects the same vertices onto up to 52 axes: gathered once per sphere pair, they are
 // not re-read through the index list and each axis is not rotated into the body per projection
@@ -665,6 +658,13 @@ struct GatheredVertices {
   std::uint32_t count = kNotGathered;
 };
 
+// One side of a sphere pair as a support function in A's frame: the faceted patch of the sphere
+// (its vertices, CollisionBody::spherePatchVertices) when it has one, else the sphere itself,
+// which bounds whatever surface the sphere is responsible for. Both are conservative: they
+// contain that surface, so an axis along which two sides do not overlap proves that the two
+// spheres' triangles do not meet.
+// A curved patch is bounded twice: by its sphere, and by its support vertices
+// (CollisionBody::sphereSupportVertices) plus their slack; the smaller of the two supports holds.
 struct PatchSide {
   const CollisionBody& body;
   std::uint32_t sphere;
