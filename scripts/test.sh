@@ -42,8 +42,10 @@ fi
 if [[ "${1:-}" == "--sanitize" ]]; then
   # The library's own tests under the sanitizers; the CLI's end-to-end tests ran in Release above
   # (CLOD_BUILD_CLI, CMakeLists.txt says why), and so did the engine plug-ins' (CLOD_BUILD_ENGINES).
+  # With clod's layers as shared libraries (CLOD_BUILD_SHARED): the Release pass tests the static
+  # ones and their install, this one that every test runs against the .so files.
   cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCLOD_SANITIZE=ON -DCLOD_BUILD_TESTS=ON \
-    -DCLOD_BUILD_CLI=OFF -DCLOD_BUILD_ENGINES=OFF "${launcher[@]}"
+    -DCLOD_BUILD_CLI=OFF -DCLOD_BUILD_ENGINES=OFF -DCLOD_BUILD_SHARED=ON "${launcher[@]}"
   cmake --build build-asan -j "$jobs"
   ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 CLOD_TEST_SCALE=sanitizer \
     ctest --test-dir build-asan -j "$jobs" --output-on-failure

@@ -33,6 +33,7 @@ struct QueryOptions {
   std::string model = "cfm";
   std::string budget;      // empty: unlimited
   std::string deadlineUs;  // empty: none
+  std::string margin;      // empty: 0
   std::int64_t maxContacts = 8;
   bool json = false;
 };
@@ -81,6 +82,7 @@ int runQuery(const QueryOptions& options) {
   std::optional<double> deadlineUs;
   if (!options.deadlineUs.empty()) deadlineUs = parseNumberOption(options.deadlineUs, "--deadline-us", 0.0, 1e12);
   settings.maxContacts = static_cast<std::uint32_t>(options.maxContacts);
+  if (!options.margin.empty()) settings.marginAbs = parseNumberOption(options.margin, "--margin", 0.0, 1e300);
 
   CollisionBody a = CollisionBody::fromBake(loadBake(options.pathA));
   CollisionBody b = CollisionBody::fromBake(loadBake(options.pathB));
@@ -142,6 +144,8 @@ const CommandRegistration kRegistration("query", [](CLI::App& app) {
   sub->add_option("--budget", options->budget, "Most sphere/triangle tests, >= 1 (default: unlimited)");
   sub->add_option("--deadline-us", options->deadlineUs, "Wall-clock deadline in microseconds, >= 0; the traversal stops early enough that turning its frontier into contacts ends by it too (include/clod/budget.h)");
   sub->add_option("--max-contacts", options->maxContacts, "Manifold size, 1..1024")->capture_default_str();
+  sub->add_option("--margin", options->margin,
+                  "Contact margin, >= 0 (bake units): bodies apart by at most this get a speculative contact at their closest points (depth < 0)");
   sub->add_flag("--json", options->json, "Print the result as JSON (colliding, contacts, tests, finished, seconds)");
   return [options] { return runQuery(*options); };
 });

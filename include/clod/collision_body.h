@@ -8,6 +8,7 @@
 // construction and any number of threads may query it at once.
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -21,6 +22,9 @@
 namespace clod {
 
 struct BakeContents;
+namespace detail {
+class TriangleBvh;
+}
 
 class CollisionBody {
 public:
@@ -127,6 +131,11 @@ public:
   bool isClosed() const noexcept { return closed_; }
   static constexpr std::uint32_t kMaxConvexCheckTriangles = 4096;
 
+  /// A box hierarchy over the mesh's triangles (the proximity layer's), built on first use --
+  /// O(T log T), thread-safe -- and shared by copies of the body: the exact closest-distance
+  /// queries (World::separation, QuerySettings::marginAbs) descend it.
+  const detail::TriangleBvh& triangleBvh() const;
+
   /// Bounding-box diagonal of the mesh: the unit of this body's relative tolerances.
   double diagonal() const noexcept { return diagonal_; }
   /// Where the body came from (a bake's source name), for messages; may be empty.
@@ -162,6 +171,8 @@ private:
   bool closed_ = false;               // every edge shared by exactly two triangles (isClosed)
   std::size_t usedVertexCount_ = 0;   // distinct vertices referenced by triangles
   std::string name_;
+  struct LazyTriangleBvh;  // triangleBvh(): built once, on first use
+  std::shared_ptr<LazyTriangleBvh> triangleBvh_;
 };
 
 }  // namespace clod

@@ -87,6 +87,16 @@ struct QuerySettings {
   /// Sphere models: sphere level; contact-tree: cell depth; ignored by the exact model (it needs
   /// the leaves' triangles). Default: no cap.
   std::uint32_t maxLevel = UINT32_MAX;
+  /// Contact margin (length units of the bodies, >= 0, finite): speculative contacts for bodies
+  /// about to touch, in every model (docs/narrow-phase.md, "Margin"). When no contact of the
+  /// model's answer penetrates beyond its errorBound and the two surfaces are at most marginAbs
+  /// apart, the result gets one more contact at their exact closest points (World::separation's descent, separation.h):
+  /// point midway, normal from B's closest point toward A's, depth = -distance (< 0), errorBound
+  /// 0, the two triangles as features (ContactFeature::kTriangle). It does not set `colliding`.
+  /// Not metered by the budget: one exact distance query, which stops as soon as the surfaces
+  /// are proven farther apart than the margin, and runs only for answers without penetration.
+  /// The contact tree's own samples within contactSampling.marginAbs come in addition. 0: off.
+  double marginAbs = 0.0;
 };
 
 /// Why a query stopped.

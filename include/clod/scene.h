@@ -12,6 +12,8 @@
 // "frontier_pair_cost" (WorldSettings::frontierPairCost, 0..1024, default 2),
 // "rolling_resistance" (WorldSettings::rollingResistanceRel, 0..1, default 0.003),
 // "max_pairs", "max_cached_node_pairs" (WorldSettings's memory limits, defaults 2^20 and 2^23),
+// "mesh_limits" {"max_vertices", "max_triangles", "max_polygon_vertices"} (MeshLoadOptions's
+// resource limits for every mesh file of the scene, defaults as there),
 // "bounds" {"min": [..], "max": [..]}, "bodies" [ ... ]. Body keys: "name", exactly one of
 // "mesh" (path relative to the scene file), "box" [hx,hy,hz] (half extents) or "sphere" r;
 // "position", "orientation" [w,x,y,z], "velocity", "angular_velocity", "torque" [x,y,z] (N m,
@@ -32,6 +34,7 @@
 #include <string_view>
 #include <vector>
 
+#include "clod/mesh_io.h"
 #include "clod/world.h"
 
 namespace clod {
@@ -68,6 +71,8 @@ struct SceneBody {
 
 struct SceneDescription {
   WorldSettings world;
+  /// Options, resource limits included, of every mesh file the scene loads ("mesh_limits").
+  MeshLoadOptions meshLoad;
   double dt = 1.0 / 60.0;
   std::uint32_t steps = 120;
   std::vector<SceneBody> bodies;

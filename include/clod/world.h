@@ -70,6 +70,7 @@
 #include "clod/budget.h"
 #include "clod/contact.h"
 #include "clod/rigid_body.h"
+#include "clod/separation.h"
 
 namespace clod {
 
@@ -104,24 +105,6 @@ struct ContactPairEvent {
 /// afresh: no warm start, no kept manifold). Runs on the stepping thread, inside World::step;
 /// it must not call World functions that edit the world (add/remove bodies, set state, forces).
 using ContactCallback = std::function<bool(const ContactPairEvent& event)>;
-
-/// Result of World::separation: the exact closest distance between two bodies' surfaces.
-struct Separation {
-  /// Closest distance between the two triangle meshes as placed now (>= 0, length units), exact
-  /// in double precision (the minimum over all triangle pairs, found by a branch-and-bound descent
-  /// of two box hierarchies); 0 when the surfaces touch or cross. When it exceeds the query's
-  /// maxDistance the descent stops early: `distance` is then only a lower bound (> maxDistance),
-  /// `withinMax` is false and the points and triangles are not set.
-  double distance = std::numeric_limits<double>::infinity();
-  bool withinMax = false;
-  /// The volumes overlap: the surfaces cross (distance 0), or one closed body lies wholly inside
-  /// the other (distance > 0 is then the gap between the inner and the outer surface).
-  bool overlapping = false;
-  Vec3 pointA = Vec3::Zero();   ///< closest point on A's surface (world frame)
-  Vec3 pointB = Vec3::Zero();   ///< closest point on B's surface (world frame)
-  std::uint32_t triangleA = 0;  ///< the triangles of A's and B's meshes the points lie on
-  std::uint32_t triangleB = 0;
-};
 
 /// A copy of `shape` scaled uniformly by `scale` (> 0, finite; else clod::Error kInvalidArgument)
 /// about its mesh origin, without baking again: mesh vertices, sphere-tree centres and radii,

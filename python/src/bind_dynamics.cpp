@@ -33,8 +33,10 @@ const char* stopName(QueryStop stop) {
 
 /// QuerySettings from the keyword arguments shared by query and query_batch.
 QuerySettings querySettings(const std::string& model, std::optional<long long> budget, std::uint32_t maxContacts,
-                            std::optional<long long> maxLevel) {
+                            std::optional<long long> maxLevel, double margin) {
   QuerySettings settings;
+  if (!(margin >= 0.0) || !std::isfinite(margin)) invalidArgument("margin: must be finite and >= 0, got " + std::to_string(margin));
+  settings.marginAbs = margin;
   settings.model = parseContactModel(model);
   if (budget) {
     const long long tests = *budget;
@@ -144,8 +146,8 @@ PyQueryResult packQueryResult(const QueryResult& r, ContactModel model) {
 
 PyQueryResult runQuery(const PyBake& a, const ArrayLike& poseA, const PyBake& b, const ArrayLike& poseB, const std::string& model,
                        std::optional<long long> budget, std::optional<double> deadlineUs, std::uint32_t maxContacts,
-                       std::optional<long long> maxLevel) {
-  QuerySettings settings = querySettings(model, budget, maxContacts, maxLevel);
+                       std::optional<long long> maxLevel, double margin) {
+  QuerySettings settings = querySettings(model, budget, maxContacts, maxLevel, margin);
   const Pose xfA = parsePose(poseA, "pose_a");
   const Pose xfB = parsePose(poseB, "pose_b");
   const std::optional<double> deadline = deadlineMicros(deadlineUs);
@@ -173,8 +175,8 @@ struct PyBatchResult {
 
 PyBatchResult runQueryBatch(const PyBake& a, const ArrayLike& posesAObj, const PyBake& b, const ArrayLike& posesBObj,
                             const std::string& model, std::optional<long long> budget, std::optional<double> deadlineUs,
-                            std::uint32_t maxContacts, std::optional<long long> maxLevel) {
-  const QuerySettings settings = querySettings(model, budget, maxContacts, maxLevel);
+                            std::uint32_t maxContacts, std::optional<long long> maxLevel, double margin) {
+  const QuerySettings settings = querySettings(model, budget, maxContacts, maxLevel, margin);
   const std::vector<Pose> posesA = parsePoses(posesAObj, "poses_a");
   const std::vector<Pose> posesB = parsePoses(posesBObj, "poses_b");
   const std::size_t count = std::max(posesA.size(), posesB.size());
@@ -704,7 +706,7 @@ void bindDynamics(py::module_& mod) {
   const QuerySettings defaults;
   mod.def("query", &runQuery, py::arg("bake_a"), py::arg("pose_a"), py::arg("bake_b"), py::arg("pose_b"), py::kw_only(),
         py::arg("model") = "cfm", py::arg("budget") = py::none(), py::arg("deadline_us") = py::none(),
-        py::arg("max_contacts") = defaults.maxContacts, py::arg("max_level") = py::none(),
+        py::arg("max_contacts") = defaults.maxContacts, py::arg("max_level") = py::none(), py::arg("margin") = 0.0,
         "Contacts between body A (bake_a placed by pose_a) and body B, from the anytime narrow phase.\n\n"
         "pose: (7,) \"tx ty tz qw qx qy qz\" (mesh -> world) or a (4, 4) rigid transform.\n"
         "model: \"dos\", \"average\", \"cfm\" (closest feature maps), \"contact-tree\" or \"exact\" (clod.contact_models).\n"
@@ -712,6 +714,8 @@ void bindDynamics(py::module_& mod) {
         "the start of the query (None = none). Running out is not an error: the result holds the contacts of\n"
         "the level reached, finished=False and stop says why. max_contacts: manifold size 1..1024.\n"
         "max_level: deepest hierarchy level to descend to (None = leaves).\n"
+        "margin: contact margin (>= 0, bake units): bodies apart by at most this get a speculative contact at\n"
+        "their exact closest points (penetration_depth = -gap; QuerySettings::marginAbs).\n"
         "Raises clod.Error(bake_missing_section) when a bake lacks what the model needs, and\n"
         "clod.InvalidArgumentError for bad poses or options. GIL released.");
 
@@ -746,7 +750,7 @@ void bindDynamics(py::module_& mod) {
       });
   mod.def("query_batch", &runQueryBatch, py::arg("bake_a"), py::arg("poses_a"), py::arg("bake_b"), py::arg("poses_b"), py::kw_only(),
         py::arg("model") = "cfm", py::arg("budget") = py::none(), py::arg("deadline_us") = py::none(),
-        py::arg("max_contacts") = defaults.maxContacts, py::arg("max_level") = py::none(),
+        py::arg("max_contacts") = defaults.maxContacts, py::arg("max_level") = py::none(), py::arg("margin") = 0.0,
         "clod.query for P pose pairs at once, in parallel (TBB, GIL released): poses_a and poses_b are (P, 7) or\n"
         "(P, 4, 4) (or one pose, used for every query). Each query gets the whole budget and deadline. Returns a\n"
         "BatchQueryResult (contacts in CSR form); query i equals clod.query with the i-th poses.");

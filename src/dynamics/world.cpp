@@ -16,7 +16,7 @@
 
 #include "clod/error.h"
 #include "clod/query.h"
-#include "separation.h"
+#include "narrowphase/separation.h"
 
 namespace clod {
 namespace {
@@ -321,7 +321,7 @@ struct World::Impl {
     std::shared_ptr<const CollisionBody> scaled;
   };
   std::vector<ScaledShape> scaledShapes;
-  mutable detail::SeparationCache separationCache;
+  mutable detail::SeparationHeap separationHeap;  // separation()'s working memory
   void filterCandidates(std::vector<BodyPair>& pairs) const;
   void applyExternalForces(double h);
   void runContactCallback();
@@ -1636,9 +1636,6 @@ void World::removeBody(BodyId id) {
   b.minExtent = std::numeric_limits<double>::infinity();
   impl_->filtering = true;
   impl_->forgetPairsOf(id);
-  bool shapeInUse = false;
-  for (const Body& other : impl_->bodies) shapeInUse = shapeInUse || (!other.removed && other.desc.shape == b.desc.shape);
-  if (!shapeInUse) impl_->separationCache.forget(b.desc.shape.get());
 }
 
 void World::setState(BodyId id, const RigidBodyState& state) {
@@ -1713,8 +1710,8 @@ Separation World::separation(BodyId a, BodyId b, double maxDistance) const {
     throw Error(ErrorCode::kInvalidArgument, "World::separation: bodies a and b are both " + std::to_string(a));
   if (!(maxDistance >= 0.0))
     throw Error(ErrorCode::kInvalidArgument, "World::separation: maxDistance must be >= 0, got " + std::to_string(maxDistance));
-  return detail::separationBetween(ba.desc.shape, ba.pose(), bb.desc.shape, bb.pose(), maxDistance,
-                                   impl_->separationCache);
+  return detail::separationBetween(*ba.desc.shape, ba.pose(), *bb.desc.shape, bb.pose(), maxDistance,
+                                   impl_->separationHeap);
 }
 
 // Drops the candidate pairs of removed bodies, pairs their filters keep apart, and pairs the

@@ -108,12 +108,13 @@ void checkPlyCounts(std::string_view text, const std::string& source, const Mesh
   });
 }
 
-// The command-line flag of a MeshLoadOptions limit: maxPolygonVertices -> max-polygon-vertices.
-std::string flagName(std::string_view option) {
+// The command-line flag (separator '-') or scene key ('_') of a MeshLoadOptions limit:
+// maxPolygonVertices -> max-polygon-vertices / max_polygon_vertices.
+std::string flagName(std::string_view option, char separator) {
   std::string flag;
   for (char c : option) {
     if (c >= 'A' && c <= 'Z') {
-      flag += '-';
+      flag += separator;
       flag += static_cast<char>(c - 'A' + 'a');
     } else {
       flag += c;
@@ -129,7 +130,8 @@ void enforceLimit(std::uint64_t count, std::uint64_t limit, std::string_view opt
   if (count <= limit) return;
   throw Error(ErrorCode::kUnsupportedMesh, where + ": " + std::to_string(count) + " " + std::string(what) +
                                                ", more than MeshLoadOptions::" + std::string(option) + " = " +
-                                               std::to_string(limit) + " (raise it to load this file: clod's --" + flagName(option) + ")");
+                                               std::to_string(limit) + " (raise it to load this file: clod's --" + flagName(option, '-') +
+                                               ", a scene's mesh_limits." + flagName(option, '_') + ")");
 }
 
 void checkDeclaredCounts(std::string_view text, std::string_view format, const std::string& source,

@@ -4,12 +4,14 @@
 #include <array>
 #include <cstdint>
 #include <cmath>
+#include <mutex>
 #include <string>
 
 #include "clod/bake.h"
 #include "clod/cell_support.h"
 #include "clod/error.h"
 #include "patch_hull.h"
+#include "proximity/triangle_bvh.h"
 
 namespace clod {
 namespace {
@@ -51,7 +53,23 @@ void checkTree(const SphereTree& tree, const TriangleMesh& mesh) {
 
 }  // namespace
 
-CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree) : mesh_(std::move(mesh)), tree_(std::move(tree)) {
+struct CollisionBody::LazyTriangleBvh {
+  std::once_flag once;
+  detail::TriangleBvh bvh;
+};
+
+const detail::TriangleBvh& CollisionBody::triangleBvh() const {
+  std::call_once(triangleBvh_->once, [this] {
+    std::vector<Aabb> boxes(mesh_.triangles.size());
+    for (std::size_t i = 0; i < boxes.size(); ++i)
+      for (std::uint32_t v : mesh_.triangles[i]) boxes[i].extend(mesh_.vertices[v]);
+    triangleBvh_->bvh = detail::TriangleBvh(boxes, detail::BvhBuildSettings{});
+  });
+  return triangleBvh_->bvh;
+}
+
+CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree)
+    : mesh_(std::move(mesh)), tree_(std::move(tree)), triangleBvh_(std::make_shared<LazyTriangleBvh>()) {
   checkTree(tree_, mesh_);
   sphereLevel_.resize(tree_.sphereCount());
   for (std::uint32_t l = 0; l < tree_.levelCount(); ++l) {

@@ -15,6 +15,7 @@
 #include "clod/error.h"
 #include "containment.h"
 #include "face_overlap.h"
+#include "separation.h"
 #include "triangle_intersection.h"
 
 namespace clod {
@@ -303,6 +304,7 @@ struct QueryScratch::Impl {
   std::vector<ContactPoint> sampled;
   std::vector<double> manifold;
   detail::ContainmentScratch containment;
+  detail::SeparationHeap separationHeap;
   // Seconds per frontier pair of turning a frontier into contacts, per model (index =
   // ContactModel), learned from this scratch's deadline queries (QueryBudget::answerWithinDeadline).
   // Starting values: medians measured on the deep benchmark poses (bench_narrowphase
@@ -1736,6 +1738,34 @@ void checkSettings(const QuerySettings& s) {
     throw Error(ErrorCode::kInvalidArgument, "mergeDistanceRel must be finite and >= 0");
   }
   if (s.budget.now == nullptr) throw Error(ErrorCode::kInvalidArgument, "budget clock is null");
+  if (!(s.marginAbs >= 0.0) || !std::isfinite(s.marginAbs)) {
+    throw Error(ErrorCode::kInvalidArgument, "marginAbs must be finite and >= 0");
+  }
+}
+
+// QuerySettings::marginAbs: one speculative contact at the exact closest points of two surfaces
+// at most `margin` apart, when no contact of `raw` (world frame) penetrates beyond its error
+// bound (a coarse or sampled contact within its bound of zero may be the bodies about to touch,
+// and is kept beside it). The closest
+// points are the answer every model would converge to for bodies apart, and a pair of points
+// is all a solver needs to stop an approach before it penetrates (Bullet and Box2D keep points
+// within a margin the same way).
+void addSpeculativeContact(const CollisionBody& a, const Pose& xfWorldFromA, const CollisionBody& b,
+                           const Pose& xfWorldFromB, double margin, std::uint32_t level,
+                           detail::SeparationHeap& heap, std::vector<Contact>& raw) {
+  if (std::any_of(raw.begin(), raw.end(), [](const Contact& c) { return c.depth - c.errorBound > 0.0; })) return;
+  const Separation gap = detail::separationBetween(a, xfWorldFromA, b, xfWorldFromB, margin, heap);
+  if (!gap.withinMax || gap.overlapping || !(gap.distance > 0.0)) return;
+  Contact c;
+  c.point = 0.5 * (gap.pointA + gap.pointB);
+  c.normal = (gap.pointA - gap.pointB) / gap.distance;
+  c.depth = -gap.distance;
+  c.errorBound = 0.0;
+  c.level = level;
+  c.featureA = gap.triangleA;
+  c.featureB = gap.triangleB;
+  c.featureKind = ContactFeature::kTriangle;
+  raw.push_back(c);
 }
 
 template <class Pair, class SideA, class SideB>
@@ -1974,6 +2004,11 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
       result.colliding = true;
       for (Contact& ct : s.raw) ct = toWorld(ct, xfWorldFromA);
     }
+  }
+
+  if (settings.marginAbs > 0.0 && !found) {
+    addSpeculativeContact(a, xfWorldFromA, b, xfWorldFromB, settings.marginAbs, result.maxLevel, s.separationHeap,
+                          s.raw);
   }
 
   result.rawContacts = s.raw.size();

@@ -95,6 +95,16 @@ SceneBakeOptions parseBake(const Reader& r, const Json& j, const std::string& pa
   return o;
 }
 
+// The same range as the CLI's --max-vertices, --max-triangles, --max-polygon-vertices.
+void parseMeshLimits(const Reader& r, const Json& j, const std::string& path, MeshLoadOptions& o) {
+  r.object(j, path, {"max_vertices", "max_triangles", "max_polygon_vertices"});
+  constexpr std::uint64_t kMost = std::uint64_t(1) << 40;
+  if (j.contains("max_vertices")) o.maxVertices = r.count(j["max_vertices"], path + ".max_vertices", 1, kMost);
+  if (j.contains("max_triangles")) o.maxTriangles = r.count(j["max_triangles"], path + ".max_triangles", 1, kMost);
+  if (j.contains("max_polygon_vertices"))
+    o.maxPolygonVertices = r.count(j["max_polygon_vertices"], path + ".max_polygon_vertices", 1, kMost);
+}
+
 SceneBody parseBody(const Reader& r, const Json& j, const std::string& path, const std::filesystem::path& baseDir,
                     std::size_t index) {
   r.object(j, path, {"name", "mesh", "box", "sphere", "position", "orientation", "velocity", "angular_velocity",
@@ -202,8 +212,8 @@ SceneDescription parseScene(std::string_view text, const std::filesystem::path& 
     throw Error(ErrorCode::kSceneError, fileName + ": not valid JSON: " + e.what());
   }
   r.object(j, "", {"gravity", "dt", "steps", "duration", "contact_model", "budget", "budget_us", "max_contacts", "min_substeps",
-                  "min_substep_iterations", "frontier_pair_cost", "rolling_resistance", "max_pairs", "max_cached_node_pairs", "bounds",
-                  "bodies"});
+                  "min_substep_iterations", "frontier_pair_cost", "rolling_resistance", "max_pairs", "max_cached_node_pairs", "mesh_limits",
+                  "bounds", "bodies"});
   SceneDescription s;
   if (j.contains("gravity")) s.world.gravity = r.vec<3>(j["gravity"], "gravity");
   if (j.contains("dt")) s.dt = r.positive(j["dt"], "dt");
@@ -243,6 +253,7 @@ SceneDescription parseScene(std::string_view text, const std::filesystem::path& 
   if (j.contains("max_pairs")) s.world.maxPairs = r.count(j["max_pairs"], "max_pairs", 1, std::uint64_t(1) << 40);
   if (j.contains("max_cached_node_pairs"))
     s.world.maxCachedNodePairs = r.count(j["max_cached_node_pairs"], "max_cached_node_pairs", 0, std::uint64_t(1) << 40);
+  if (j.contains("mesh_limits")) parseMeshLimits(r, j["mesh_limits"], "mesh_limits", s.meshLoad);
   if (j.contains("bounds")) {
     r.object(j["bounds"], "bounds", {"min", "max"});
     if (!j["bounds"].contains("min") || !j["bounds"].contains("max")) r.fail("bounds", "needs \"min\" and \"max\"");
@@ -274,7 +285,7 @@ World buildWorld(const SceneDescription& scene, const std::filesystem::path& cac
     if (sb.shape == SceneShapeKind::kMesh) {
       const std::string key = sb.meshPath.string();
       auto it = meshFiles.find(key);
-      if (it == meshFiles.end()) it = meshFiles.emplace(key, loadMesh(sb.meshPath).mesh).first;
+      if (it == meshFiles.end()) it = meshFiles.emplace(key, loadMesh(sb.meshPath, scene.meshLoad).mesh).first;
       mesh = it->second;
       if (sb.scale != 1.0)
         for (Vec3& v : mesh.vertices) v *= sb.scale;

@@ -14,7 +14,7 @@
 #include "clod/primitives.h"
 #include "clod/query.h"
 #include "clod/world.h"
-#include "dynamics/separation.h"
+#include "narrowphase/separation.h"
 #include "dynamics/world_test_support.h"
 #include "support/test_scale.h"
 

@@ -17,7 +17,7 @@
 #include "clod/primitives.h"
 #include "clod/proximity.h"
 #include "clod/world.h"
-#include "dynamics/separation.h"
+#include "narrowphase/separation.h"
 #include "dynamics/world_test_support.h"
 
 namespace clod {

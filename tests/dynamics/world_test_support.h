@@ -12,7 +12,7 @@
 #include "clod/contact_tree_builder.h"
 #include "clod/primitives.h"
 #include "clod/proximity.h"
-#include "dynamics/separation.h"
+#include "narrowphase/separation.h"
 
 namespace clod::test {
 

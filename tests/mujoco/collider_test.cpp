@@ -70,6 +70,39 @@ TEST(MujocoCollider, CubeOnCubeFollowsMujocoConventions) {
   }
 }
 
+// MuJoCo's geom margin: cubes 0.01 apart face to face count as a contact (dist > 0) when the
+// margin is larger, through clod's speculative contact (QuerySettings::marginAbs). Analytic: one
+// contact at dist 0.01, normal up from the lower cube (geom1) to the upper, pos midway.
+TEST(MujocoCollider, GeomMarginGivesCubesApartOneContactAtTheirGap) {
+  for (const double margin : {0.02, 0.005}) {
+    SCOPED_TRACE("margin " + std::to_string(margin));
+    const std::string m2 = "margin=\"" + std::to_string(margin) + "\" ";
+    const std::string xml = "<mujoco><asset>" + test::inlineMesh("cube", makeBox(Vec3(0.5, 0.5, 0.5))) +
+                            "</asset><worldbody><geom name=\"lower\" type=\"mesh\" mesh=\"cube\" " + m2 +
+                            "/><body name=\"upper\" pos=\"0.1 0 1.01\"><freejoint/><geom name=\"upper\" type=\"mesh\" "
+                            "mesh=\"cube\" " + m2 + "/></body></worldbody></mujoco>";
+    mujoco::ModelPtr m = test::loadXmlText(xml, "cubes.xml");
+    mujoco::DataPtr d(mj_makeData(m.get()));
+    ColliderSettings settings;
+    settings.model = ContactModel::kCfm;
+    Collider collider(settings);
+    collider.addModel(m.get());
+    collider.install();
+    mj_forward(m.get(), d.get());
+    collider.uninstall();
+    if (margin < 0.01) {
+      EXPECT_EQ(d->ncon, 0);
+      continue;
+    }
+    ASSERT_EQ(d->ncon, 1);
+    const mjContact& c = d->contact[0];
+    expectFrame(c);
+    EXPECT_NEAR(c.dist, 0.01, 1e-9);
+    EXPECT_NEAR(c.frame[2], 1.0, 1e-9);
+    EXPECT_NEAR(c.pos[2], 0.505, 1e-9);
+  }
+}
+
 TEST(MujocoCollider, UninstallRestoresMujocosOwnFunctions) {
   mjfCollision before[mjNGEOMTYPES][mjNGEOMTYPES];
   for (int i = 0; i < mjNGEOMTYPES; ++i)

@@ -97,6 +97,21 @@ def test_separated_boxes_give_no_contacts(box_bake):
     assert not res.colliding and len(res) == 0 and res.pos.shape == (0, 3)
 
 
+@pytest.mark.parametrize("model", ["cfm", "contact-tree", "exact"])
+def test_margin_gives_boxes_apart_their_gap_as_a_speculative_contact(box_bake, model):
+    """Two 1 m boxes 0.03 apart face to face: with margin 0.05 one contact at depth -0.03 (the
+    analytic gap), normal from B toward A, its points on the two faces; margin 0.02: none."""
+    pose_b = np.array([0.2, 0.1, 1.03, 1, 0, 0, 0], dtype=np.float64)
+    res = clod.query(box_bake, IDENTITY, box_bake, pose_b, model=model, margin=0.05)
+    assert len(res.penetration_depth) == 1 and not res.colliding
+    assert res.penetration_depth[0] == pytest.approx(-0.03, abs=1e-9)
+    np.testing.assert_allclose(res.normal[0], [0, 0, -1], atol=1e-9)
+    assert res.point_on_a[0][2] == pytest.approx(0.5, abs=1e-9) and res.point_on_b[0][2] == pytest.approx(0.53, abs=1e-9)
+    assert len(clod.query(box_bake, IDENTITY, box_bake, pose_b, model=model, margin=0.02).penetration_depth) == 0
+    with pytest.raises(clod.InvalidArgumentError):
+        clod.query(box_bake, IDENTITY, box_bake, pose_b, model=model, margin=-1.0)
+
+
 def test_spheres_give_the_centre_line_normal_and_depth(sphere_bake):
     # Two unit spheres 1.9 apart along a tilted axis: they penetrate by 0.1 along the centre line and
     # their surfaces cross on the circle of radius sqrt(1 - 0.95^2) in the plane 0.95 along the axis.

@@ -50,6 +50,9 @@ TEST(SceneParse, OutOfRangeAndConflictingValuesAreErrors) {
             std::string::npos);
   EXPECT_NE(sceneError(R"({"bodies": [], "max_pairs": 0})").find("max_pairs"), std::string::npos);
   EXPECT_NE(sceneError(R"({"bodies": [], "max_cached_node_pairs": -1})").find("max_cached_node_pairs"), std::string::npos);
+  EXPECT_NE(sceneError(R"({"bodies": [], "mesh_limits": {"max_triangles": 0}})").find("mesh_limits.max_triangles"),
+            std::string::npos);
+  EXPECT_EQ(sceneError(R"({"bodies": [], "mesh_limits": {"max_faces": 9}})"), "t.json: mesh_limits.max_faces: unknown key");
   EXPECT_NE(sceneError("{not json").find("not valid JSON"), std::string::npos);
   EXPECT_NE(sceneError(R"({"dt": 0.01})").find("bodies: missing"), std::string::npos);
 }
@@ -58,6 +61,7 @@ TEST(SceneParse, ReadsEveryFieldAsWritten) {
   const SceneDescription s = parseScene(R"({"gravity": [0, 0, -1], "dt": 0.01, "duration": 0.5,
       "contact_model": "exact", "budget": 64, "budget_us": 1500, "max_contacts": 4, "min_substeps": 3,
       "min_substep_iterations": 7, "frontier_pair_cost": 5, "max_pairs": 1000, "max_cached_node_pairs": 0,
+      "mesh_limits": {"max_vertices": 11, "max_triangles": 22, "max_polygon_vertices": 33},
       "bodies": [{"name": "a", "box": [1, 2, 3], "static": true},
                  {"name": "b", "sphere": 0.25, "position": [1, 2, 3], "orientation": [0, 0, 0, 2],
                   "velocity": [4, 5, 6], "angular_velocity": [7, 8, 9], "torque": [1, -2, 3], "mass": 3, "restitution": 0.5,
@@ -75,6 +79,9 @@ TEST(SceneParse, ReadsEveryFieldAsWritten) {
   EXPECT_EQ(s.world.frontierPairCost, 5u);
   EXPECT_EQ(s.world.maxPairs, 1000u);
   EXPECT_EQ(s.world.maxCachedNodePairs, 0u);
+  EXPECT_EQ(s.meshLoad.maxVertices, 11u);
+  EXPECT_EQ(s.meshLoad.maxTriangles, 22u);
+  EXPECT_EQ(s.meshLoad.maxPolygonVertices, 33u);
   ASSERT_EQ(s.bodies.size(), 3u);
   EXPECT_EQ(s.bodies[0].type, BodyType::kStatic);
   EXPECT_EQ(s.bodies[0].halfExtents, Vec3(1, 2, 3));
@@ -121,6 +128,25 @@ TEST(SceneBuild, ConstantTorqueSpinsAFreeBodyAsIAlphaEqualsTau) {
   }
   EXPECT_NEAR(world.state(0).angularVelocity.z(), 0.2, 1e-9);
   EXPECT_NEAR(world.state(0).angularVelocity.head<2>().norm(), 0.0, 1e-12);
+}
+
+// The scene's mesh limits reach the loader: box.obj has 8 vertices and 12 triangles, so a limit
+// of 11 triangles refuses it (kUnsupportedMesh, naming the limit) and 12 loads it.
+TEST(SceneBuild, MeshLimitsOfTheSceneRefuseALargerMeshFile) {
+  const std::string mesh = std::string(CLOD_TEST_DATA_DIR) + "/good/box.obj";
+  auto scene = [&](int maxTriangles) {
+    return parseScene(R"({"mesh_limits": {"max_triangles": )" + std::to_string(maxTriangles) + R"(},
+                          "bodies": [{"mesh": ")" + mesh + R"(", "bake": {"depth": 1}}]})",
+                      ".", "t.json");
+  };
+  try {
+    buildWorld(scene(11), {});
+    ADD_FAILURE() << "a 12-triangle mesh loaded under max_triangles 11";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kUnsupportedMesh) << e.what();
+    EXPECT_NE(std::string(e.what()).find("maxTriangles"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(buildWorld(scene(12), {}).bodyCount(), 1u);
 }
 
 TEST(SceneBuild, SecondBuildLoadsShapesFromTheCache) {

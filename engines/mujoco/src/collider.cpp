@@ -311,6 +311,9 @@ int Collider::Impl::collide(const mjModel* m, const mjData* d, mjContact* con, i
     if (settings.budgetMicros > 0.0)
       query.budget.deadline = ds.stepStart + std::chrono::duration_cast<Clock::duration>(
                                                  std::chrono::duration<double, std::micro>(settings.budgetMicros));
+    // MuJoCo's margin: contacts up to `margin` apart count (mjContact::dist > 0), so the query
+    // adds the closest points of surfaces within it as a speculative contact (QuerySettings::marginAbs).
+    query.marginAbs = margin > 0.0 && std::isfinite(margin) ? double(margin) : 0.0;
     // A is geom1 and B geom2: clod's normals (B -> A) are MuJoCo's (geom1 -> geom2) negated.
     queryContacts(*body1, pose1, *body2, pose2, query, scratch, result, settings.coherence ? &ps.cache : nullptr);
     const std::uint64_t spent = result.tests + cost * result.frontier.size();
@@ -325,7 +328,8 @@ int Collider::Impl::collide(const mjModel* m, const mjData* d, mjContact* con, i
     for (const Contact& c : result.contacts) {
       if (std::size_t(n) >= limit) break;
       double depth = c.depth;
-      if (settings.depthReport == DepthReport::kCertainDepth) depth = std::max(0.0, depth - c.errorBound);
+      // A speculative contact (depth < 0) keeps its gap: only a penetration has an uncertain part.
+      if (settings.depthReport == DepthReport::kCertainDepth && depth > 0.0) depth = std::max(0.0, depth - c.errorBound);
       const Vec3 normal = -c.normal;
       const Vec3 p1 = c.point + 0.5 * depth * normal, p2 = c.point - 0.5 * depth * normal;
       ps.anchors.push_back({pose1.applyInverse(p1), pose2.applyInverse(p2), pose1.rotation.conjugate() * normal});

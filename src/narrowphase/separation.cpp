@@ -1,4 +1,4 @@
-// World::separation: exact closest distance between two placed meshes (separation.h).
+// The exact closest distance between two placed meshes (separation.h).
 #include "separation.h"
 
 #include <algorithm>
@@ -7,6 +7,7 @@
 
 #include "clod/proximity.h"
 #include "narrowphase/containment.h"
+#include "proximity/triangle_bvh.h"
 
 namespace clod::detail {
 namespace {
@@ -134,27 +135,12 @@ TriangleDistance triangleDistance(const Vec3& a0, const Vec3& a1, const Vec3& a2
   return best;
 }
 
-const TriangleBvh& SeparationCache::bvh(const std::shared_ptr<const CollisionBody>& shape) {
-  auto it = entries_.find(shape.get());
-  if (it == entries_.end()) {
-    const TriangleMesh& mesh = shape->mesh();
-    std::vector<Aabb> boxes(mesh.triangles.size());
-    for (std::size_t i = 0; i < boxes.size(); ++i)
-      for (std::uint32_t v : mesh.triangles[i]) boxes[i].extend(mesh.vertices[v]);
-    it = entries_.emplace(shape.get(), std::make_pair(shape, TriangleBvh(boxes, BvhBuildSettings{}))).first;
-  }
-  return it->second.second;
-}
-
-void SeparationCache::forget(const CollisionBody* shape) { entries_.erase(shape); }
-
-Separation separationBetween(const std::shared_ptr<const CollisionBody>& shapeA, const Pose& poseA,
-                             const std::shared_ptr<const CollisionBody>& shapeB, const Pose& poseB, double maxDistance,
-                             SeparationCache& cache) {
-  const TriangleBvh& ta = cache.bvh(shapeA);
-  const TriangleBvh& tb = cache.bvh(shapeB);
-  const TriangleMesh& ma = shapeA->mesh();
-  const TriangleMesh& mb = shapeB->mesh();
+Separation separationBetween(const CollisionBody& shapeA, const Pose& poseA, const CollisionBody& shapeB,
+                             const Pose& poseB, double maxDistance, SeparationHeap& heap) {
+  const TriangleBvh& ta = shapeA.triangleBvh();
+  const TriangleBvh& tb = shapeB.triangleBvh();
+  const TriangleMesh& ma = shapeA.mesh();
+  const TriangleMesh& mb = shapeB.mesh();
   // Everything in A's frame: B's triangles are moved there as they are met.
   const Pose xf = poseA.inverse() * poseB;
   const Mat3 absRotation = xf.rotation.toRotationMatrix().cwiseAbs();
@@ -163,9 +149,8 @@ Separation separationBetween(const std::shared_ptr<const CollisionBody>& shapeA,
   double dropped = std::numeric_limits<double>::infinity(); // smallest bound left unexplored > maxDistance
   TriangleDistance bestPair;
   std::uint32_t bestA = 0, bestB = 0;
-  auto& heap = cache.heap;
   heap.clear();
-  auto greater = [](const SeparationCache::Item& l, const SeparationCache::Item& r) { return l.lowerBound > r.lowerBound; };
+  auto greater = [](const SeparationItem& l, const SeparationItem& r) { return l.lowerBound > r.lowerBound; };
   auto push = [&](std::uint32_t ra, std::uint32_t rb) {
     const double bound = boxLowerBound(refBox(ta, ra), refBox(tb, rb), xf, absRotation);
     if (bound > maxDistance) {
@@ -184,7 +169,7 @@ Separation separationBetween(const std::shared_ptr<const CollisionBody>& shapeA,
   push(kRoot, kRoot);
   while (!heap.empty() && best2 > 0.0) {
     std::pop_heap(heap.begin(), heap.end(), greater);
-    const SeparationCache::Item item = heap.back();
+    const SeparationItem item = heap.back();
     heap.pop_back();
     if (item.lowerBound * item.lowerBound >= best2) break;  // the heap holds nothing nearer
     const bool leafA = isLeafRef(ta, item.a), leafB = isLeafRef(tb, item.b);
@@ -239,7 +224,7 @@ Separation separationBetween(const std::shared_ptr<const CollisionBody>& shapeA,
       const Vec3 p = xfOuterFromInner.apply(inner.vertices[inner.triangles[0][0]]);
       return exactBodyField(outer, p, scratch).distance < 0.0;
     };
-    out.overlapping = inside(*shapeB, ma, xf.inverse()) || inside(*shapeA, mb, xf);
+    out.overlapping = inside(shapeB, ma, xf.inverse()) || inside(shapeA, mb, xf);
   }
   return out;
 }
