@@ -37,6 +37,12 @@ endfunction()
 set(prefix ${WORK_DIR}/prefix)
 file(REMOVE_RECURSE ${WORK_DIR})
 step("install" ${CMAKE_COMMAND} --install ${CLOD_BINARY_DIR} --prefix ${prefix})
+# 0. The installed tool starts from the prefix alone (a shared build: every library it links is
+# installed, and found through its run path).
+if(EXISTS ${prefix}/bin/clod)
+  step("installed clod --version" ${prefix}/bin/clod --version)
+  message(STATUS "installed tool: ${step_output}")
+endif()
 
 # 1. CMake: find_package(clod REQUIRED) with only the fresh prefix to find it in.
 set(launcher "")
