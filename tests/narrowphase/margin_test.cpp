@@ -61,15 +61,21 @@ void expectSpeculativeContact(const QueryResult& r, double gap, double pointZ, s
   EXPECT_NEAR(contactPointOnB(c).z(), pointZ + gap / 2, 1e-9);
 }
 
+// Body B at poseB over the ground, queried with a margin.
+QueryResult queryOverGround(const CollisionBody& b, const Pose& poseB, ContactModel model, std::uint64_t budget,
+                            double margin) {
+  QuerySettings s = settingsFor(model, budget);
+  s.marginAbs = margin;
+  return queryContacts(ground(), Pose{}, b, poseB, s);
+}
+
 TEST(ContactMargin, ParallelFacesAGapApartGetTheirGapInEveryModel) {
   const CollisionBody cube = test::makeTestBody(makeBox(Vec3::Constant(0.5)), 2);
   const double gap = 0.01;
   const Pose poseB{Quat::Identity(), Vec3(0.3, -0.2, 0.5 + gap + 0.5)};
   for (ContactModel model : kModels) {
     for (std::uint64_t budget : kBudgets) {
-      QuerySettings s = settingsFor(model, budget);
-      s.marginAbs = 0.02;
-      const QueryResult r = queryContacts(ground(), Pose{}, cube, poseB, s);
+      const QueryResult r = queryOverGround(cube, poseB, model, budget, 0.02);
       expectSpeculativeContact(r, gap, 0.5 + gap / 2, contactModelName(model));
       EXPECT_FALSE(r.colliding);
       // The closest points of two parallel faces: anywhere in their overlap, |x - 0.3| and
@@ -77,8 +83,7 @@ TEST(ContactMargin, ParallelFacesAGapApartGetTheirGapInEveryModel) {
       EXPECT_LE(std::abs(r.contacts.front().point.x() - 0.3), 0.5 + 1e-9);
       EXPECT_LE(std::abs(r.contacts.front().point.y() + 0.2), 0.5 + 1e-9);
       // A margin below the gap: no contact at all.
-      s.marginAbs = 0.009;
-      EXPECT_TRUE(queryContacts(ground(), Pose{}, cube, poseB, s).contacts.empty()) << contactModelName(model);
+      EXPECT_TRUE(queryOverGround(cube, poseB, model, budget, 0.009).contacts.empty()) << contactModelName(model);
     }
   }
 }
@@ -91,9 +96,7 @@ TEST(ContactMargin, EdgeOverAFaceGetsTheEdgesGapInEveryModel) {
                    Vec3(0.0, 0.1, 0.5 + gap + 0.5 * std::sqrt(2.0))};
   for (ContactModel model : kModels) {
     for (std::uint64_t budget : kBudgets) {
-      QuerySettings s = settingsFor(model, budget);
-      s.marginAbs = 0.01;
-      const QueryResult r = queryContacts(ground(), Pose{}, cube, poseB, s);
+      const QueryResult r = queryOverGround(cube, poseB, model, budget, 0.01);
       expectSpeculativeContact(r, gap, 0.5 + gap / 2, contactModelName(model));
       EXPECT_FALSE(r.colliding);
       EXPECT_NEAR(r.contacts.front().point.y(), 0.1, 1e-9);  // under the edge
@@ -117,9 +120,7 @@ TEST(ContactMargin, CurvedMeshesOverAFaceGetTheirLowestVertexGap) {
       poseB.translation.z() += 0.5 + gap - lowest;
       for (ContactModel model : kModels) {
         for (std::uint64_t budget : kBudgets) {
-          QuerySettings s = settingsFor(model, budget);
-          s.marginAbs = 0.02;
-          const QueryResult r = queryContacts(ground(), Pose{}, shape, poseB, s);
+          const QueryResult r = queryOverGround(shape, poseB, model, budget, 0.02);
           expectSpeculativeContact(r, gap, 0.5 + gap / 2, contactModelName(model));
         }
       }
@@ -132,10 +133,8 @@ TEST(ContactMargin, PenetratingBodiesGetTheModelsAnswerUnchanged) {
   const CollisionBody cube = test::makeTestBody(makeBox(Vec3::Constant(0.5)), 2);
   const Pose poseB{Quat(Eigen::AngleAxisd(0.3, Vec3::UnitZ())), Vec3(0.1, 0.0, 0.99)};
   for (ContactModel model : kModels) {
-    QuerySettings s = settingsFor(model, kUnlimitedTests);
-    const QueryResult plain = queryContacts(ground(), Pose{}, cube, poseB, s);
-    s.marginAbs = 0.05;
-    const QueryResult withMargin = queryContacts(ground(), Pose{}, cube, poseB, s);
+    const QueryResult plain = queryOverGround(cube, poseB, model, kUnlimitedTests, 0.0);
+    const QueryResult withMargin = queryOverGround(cube, poseB, model, kUnlimitedTests, 0.05);
     ASSERT_FALSE(plain.contacts.empty());
     ASSERT_EQ(withMargin.contacts.size(), plain.contacts.size()) << contactModelName(model);
     for (std::size_t i = 0; i < plain.contacts.size(); ++i) {
