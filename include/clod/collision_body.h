@@ -131,6 +131,11 @@ public:
   bool isClosed() const noexcept { return closed_; }
   static constexpr std::uint32_t kMaxConvexCheckTriangles = 4096;
 
+  /// The triangle across edge k (corners k and k + 1 mod 3) of triangle t, or kNoNeighbour where
+  /// that edge is a border or shared by more than two triangles. O(1).
+  std::uint32_t triangleNeighbour(std::uint32_t t, int k) const noexcept { return neighbours_[3 * std::size_t{t} + k]; }
+  static constexpr std::uint32_t kNoNeighbour = 0xffffffffu;
+
   /// A box hierarchy over the mesh's triangles (the proximity layer's), built on first use --
   /// O(T log T), thread-safe -- and shared by copies of the body: the exact closest-distance
   /// queries (World::separation, QuerySettings::marginAbs) descend it.
@@ -148,6 +153,7 @@ private:
   };
   void classifyConvexPolyhedron(std::span<const EdgeRef> sortedEdges);
   void computeVertexNormals();
+  void findNeighbours(std::span<const EdgeRef> sortedEdges);
 
   TriangleMesh mesh_;
   SphereTree tree_;
@@ -166,6 +172,7 @@ private:
   std::vector<std::uint32_t> innerVertexOffsets_;
   std::vector<std::uint32_t> innerVertices_;
   std::vector<Vec3f> vertexNormals_;
+  std::vector<std::uint32_t> neighbours_;  // 3 per triangle (triangleNeighbour)
   double diagonal_ = 0.0;
   bool convexPolyhedron_ = false;     // closed and convex (isConvexPolyhedron)
   bool closed_ = false;               // every edge shared by exactly two triangles (isClosed)

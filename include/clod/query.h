@@ -42,10 +42,11 @@
 // separate patches even where they share a large triangle. Every contact carries its patch's
 // normal, the gradient of the patch's intersection volume (B's surface inside A minus A's
 // surface inside B, area-weighted normals, each intersecting triangle clipped by the other
-// body's triangles it meets in that patch), and its patch's depth, the distance along that normal
-// between the patch's two inside surfaces' centroids (docs/narrow-phase.md; where a face lies
-// wholly inside the other body, e.g. a box's bottom sunk into a slab, it crosses nothing and does
-// not count, and the depth is half the penetration). A flush coplanar patch gets its face normal
+// body's triangles it meets in that patch), and its patch's depth: where one side is flat, the
+// intersection volume over its area projected along that normal, the triangles wholly inside the
+// other body counted (a box's bottom sunk into a slab crosses nothing): a flat penetration
+// exactly; where both sides are curved, the distance along the normal between the two inside
+// surfaces' centroids, half a lens's thickness (docs/narrow-phase.md). A flush coplanar patch gets its face normal
 // and depth 0. In a curved patch (on both sides the inside pieces' normals spread by more than
 // 1 deg: a thread's helical band, not a box's face) a contact whose own triangle pair is
 // conformal (faces within 20 deg of facing each other) or one-sided (one inside piece >= 10x the

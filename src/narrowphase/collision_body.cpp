@@ -201,7 +201,30 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree)
     innerVertexOffsets_.push_back(static_cast<std::uint32_t>(innerVertices_.size()));
   }
   classifyConvexPolyhedron(edges);
+  findNeighbours(edges);
   computeVertexNormals();
+}
+
+void CollisionBody::findNeighbours(std::span<const EdgeRef> sortedEdges) {
+  neighbours_.assign(3 * std::size_t{mesh_.triangleCount()}, kNoNeighbour);
+  auto edgeIndex = [this](std::uint32_t t, std::uint32_t v0, std::uint32_t v1) {
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t u = mesh_.triangles[t][k], w = mesh_.triangles[t][(k + 1) % 3];
+      if (std::min(u, w) == v0 && std::max(u, w) == v1) return k;
+    }
+    return 0;  // not reached: the edge came from this triangle
+  };
+  for (std::size_t i = 0; i < sortedEdges.size();) {
+    std::size_t j = i;
+    while (j < sortedEdges.size() && sortedEdges[j].v0 == sortedEdges[i].v0 && sortedEdges[j].v1 == sortedEdges[i].v1) ++j;
+    if (j - i == 2) {
+      const EdgeRef& x = sortedEdges[i];
+      const EdgeRef& y = sortedEdges[i + 1];
+      neighbours_[3 * std::size_t{x.triangle} + edgeIndex(x.triangle, x.v0, x.v1)] = y.triangle;
+      neighbours_[3 * std::size_t{y.triangle} + edgeIndex(y.triangle, y.v0, y.v1)] = x.triangle;
+    }
+    i = j;
+  }
 }
 
 // Vertex normals weighted by the triangles' angles at the vertex (Thuermer and Wuethrich 1998:

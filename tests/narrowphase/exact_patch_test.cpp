@@ -70,13 +70,13 @@ QuerySettings exactSettings(std::uint32_t maxContacts) {
 }
 
 // Normals point from B (ground) toward A (cube): the slab's top pushes the cube up (+z), the
-// block's -x face pushes it back (-x). Depth, analytically: the model's depth is the distance
-// along the normal between the area centroids of the two inside surfaces (query.h). At the slab,
-// the cube's inside surface is its four side strips of height kSlabPenetration (the bottom lies
-// wholly inside the slab and crosses nothing, so it does not count: docs/narrow-phase.md),
-// centroid at z = -kSlabPenetration / 2, and the slab's is the 2 x 2 square at z = 0: depth
-// kSlabPenetration / 2. At the block, likewise kBlockPenetration / 2. Tolerance: 1e-9 of the
-// scene's ~8.5 m diagonal, far above rounding, far below the 5 mm between the two depths.
+// block's -x face pushes it back (-x). Depth, analytically: a patch's depth is its intersection
+// volume over its area projected along the normal (docs/narrow-phase.md, "Depth"): at the slab
+// the overlap is a 2 x 2 x kSlabPenetration slab of the cube, so kSlabPenetration; at the block
+// kBlockPenetration. (Before the cube's bottom -- wholly inside the slab, crossing nothing --
+// was part of its inside surface, the depth was the side strips' centroid: half of these.)
+// Tolerance: 1e-9 of the scene's ~8.5 m diagonal, far above rounding, far below the 30 mm
+// between the two depths.
 constexpr double kDepthTolerance = 1e-8;
 
 TEST(ExactModelPatches, SlabAndRaisedBlockGiveTwoPatchesWithTheirOwnNormalAndDepth) {
@@ -95,12 +95,12 @@ TEST(ExactModelPatches, SlabAndRaisedBlockGiveTwoPatchesWithTheirOwnNormalAndDep
       ++blockContacts;
       EXPECT_NEAR(c.point.x(), 1.0 - 0.5 * kBlockPenetration, 0.5 * kBlockPenetration + 1e-9) << c.point.transpose();
       EXPECT_LT(angleBetween(c.normal, -Vec3::UnitX()), 2.0 * kDegree) << c.normal.transpose();
-      EXPECT_NEAR(c.depth, 0.5 * kBlockPenetration, kDepthTolerance) << c.point.transpose();
+      EXPECT_NEAR(c.depth, kBlockPenetration, kDepthTolerance) << c.point.transpose();
     } else {
       ++slabContacts;
       EXPECT_NEAR(c.point.z(), -0.5 * kSlabPenetration, 0.5 * kSlabPenetration + 1e-9) << c.point.transpose();
       EXPECT_LT(angleBetween(c.normal, Vec3::UnitZ()), 2.0 * kDegree) << c.normal.transpose();
-      EXPECT_NEAR(c.depth, 0.5 * kSlabPenetration, kDepthTolerance) << c.point.transpose();
+      EXPECT_NEAR(c.depth, kSlabPenetration, kDepthTolerance) << c.point.transpose();
     }
   }
   EXPECT_GE(slabContacts, 3);   // the cube's footprint on the slab
@@ -118,7 +118,7 @@ TEST(ExactModelPatches, SlabAndRaisedBlockGiveTwoPatchesWithTheirOwnNormalAndDep
   EXPECT_GE(up, 1);
   EXPECT_GE(back, 1);
   ASSERT_FALSE(reduced.contacts.empty());
-  EXPECT_NEAR(reduced.contacts.front().depth, 0.5 * kBlockPenetration, kDepthTolerance);  // deepest first
+  EXPECT_NEAR(reduced.contacts.front().depth, kBlockPenetration, kDepthTolerance);  // deepest first
 }
 
 // The same scene with the block moved off the cube: one patch, the slab's, as before.
@@ -131,7 +131,32 @@ TEST(ExactModelPatches, WithoutTheBlockOnlyTheSlabPatchRemains) {
   ASSERT_FALSE(r.contacts.empty());
   for (const Contact& c : r.contacts) {
     EXPECT_LT(angleBetween(c.normal, Vec3::UnitZ()), 2.0 * kDegree) << c.normal.transpose();
-    EXPECT_NEAR(c.depth, 0.5 * kSlabPenetration, kDepthTolerance);
+    EXPECT_NEAR(c.depth, kSlabPenetration, kDepthTolerance);
+  }
+}
+
+// A pillar much narrower than it is sunk deep relative to its width: its bottom (wholly inside
+// the bed, crossing nothing) is most of the overlap's boundary below and its side strips are
+// 40 % of the inside surface, so a depth from the inside surfaces' centroids (0.005 without the
+// bottom, 0.0086 with it) is far from the analytic 0.01; the volume over the projected area is
+// exact. The bed is two boxes in one mesh, so the pair is not two convex polyhedra (the
+// separating-axis path). Tolerance as above.
+TEST(ExactModelPatches, NarrowPillarSunkIntoABedGetsTheFullDepth) {
+  TriangleMesh bed;
+  appendMoved(bed, makeBox(Vec3(1.0, 1.0, 0.1)), Vec3(0.0, 0.0, -0.1));
+  appendMoved(bed, makeBox(Vec3(1.0, 1.0, 0.1)), Vec3(3.0, 0.0, -0.1));
+  const CollisionBody bedBody = test::makeTestBody(bed, 2, false, false);
+  const CollisionBody pillar = test::makeTestBody(makeBox(Vec3(0.05, 0.05, 0.5)), 2, false, false);
+  for (const double depth : {0.002, 0.01, 0.03}) {
+    Pose pose;
+    pose.translation = Vec3(0.3, 0.2, 0.5 - depth);
+    const QueryResult r = queryContacts(bedBody, Pose{}, pillar, pose, exactSettings(8));
+    ASSERT_TRUE(r.finished);
+    ASSERT_FALSE(r.contacts.empty());
+    for (const Contact& c : r.contacts) {
+      EXPECT_NEAR(c.depth, depth, kDepthTolerance);
+      EXPECT_LT(angleBetween(c.normal, -Vec3::UnitZ()), 0.01 * kDegree) << c.normal.transpose();
+    }
   }
 }
 
