@@ -33,6 +33,14 @@ void expectFrame(const mjContact& c) {
   EXPECT_NEAR(f.determinant(), 1.0, 1e-12);
 }
 
+// One mj_forward of `m` with `collider` installed for it, uninstalled afterwards.
+void forwardOnce(Collider& collider, const mjModel* m, mjData* d) {
+  collider.addModel(m);
+  collider.install();
+  mj_forward(m, d);
+  collider.uninstall();
+}
+
 TEST(MujocoCollider, CubeOnCubeFollowsMujocoConventions) {
   for (const bool upperFirst : {false, true}) {
     for (const double yaw : {0.0, 30.0}) {
@@ -42,10 +50,7 @@ TEST(MujocoCollider, CubeOnCubeFollowsMujocoConventions) {
       ColliderSettings settings;
       settings.model = ContactModel::kExact;
       Collider collider(settings);
-      collider.addModel(m.get());
-      collider.install();
-      mj_forward(m.get(), d.get());
-      collider.uninstall();
+      forwardOnce(collider, m.get(), d.get());
       ASSERT_GE(d->ncon, 3) << "a face-on-face contact needs a support polygon";
       const int upperGeom = mj_name2id(m.get(), mjOBJ_GEOM, "upper");
       for (int i = 0; i < d->ncon; ++i) {
@@ -86,10 +91,7 @@ TEST(MujocoCollider, GeomMarginGivesCubesApartOneContactAtTheirGap) {
     ColliderSettings settings;
     settings.model = ContactModel::kCfm;
     Collider collider(settings);
-    collider.addModel(m.get());
-    collider.install();
-    mj_forward(m.get(), d.get());
-    collider.uninstall();
+    forwardOnce(collider, m.get(), d.get());
     if (margin < 0.01) {
       EXPECT_EQ(d->ncon, 0);
       continue;
