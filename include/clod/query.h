@@ -46,9 +46,10 @@
 // intersection volume over its area projected along that normal, the triangles wholly inside the
 // other body counted (a box's bottom sunk into a slab crosses nothing): a flat penetration
 // exactly; where both sides are curved, the distance along the normal between the two inside
-// surfaces' centroids, half a lens's thickness (docs/narrow-phase.md). A flush coplanar patch gets its face normal
-// and depth 0. In a curved patch (on both sides the inside pieces' normals spread by more than
-// 1 deg: a thread's helical band, not a box's face) a contact whose own triangle pair is
+// surfaces' centroids, half a lens's thickness (docs/narrow-phase.md). A flush coplanar patch
+// gets its face normal and depth 0. In a curved patch (on both sides the inside pieces'
+// normals spread by more than 1 deg: a thread's helical band, not a box's face) a contact whose
+// own triangle pair is
 // conformal (faces within 20 deg of facing each other) or one-sided (one inside piece >= 10x the
 // other's) takes that pair's own volume gradient as its normal instead, when within 45 deg of
 // the patch's (the depth stays the patch's): per-point normals, so a nut on a bolt's flank is pushed along the helix
@@ -91,9 +92,10 @@ struct QuerySettings {
   /// Contact margin (length units of the bodies, >= 0, finite): speculative contacts for bodies
   /// about to touch, in every model (docs/narrow-phase.md, "Margin"). When no contact of the
   /// model's answer penetrates beyond its errorBound and the two surfaces are at most marginAbs
-  /// apart, the result gets one more contact at their exact closest points (World::separation's descent, separation.h):
-  /// point midway, normal from B's closest point toward A's, depth = -distance (< 0), errorBound
-  /// 0, the two triangles as features (ContactFeature::kTriangle). It does not set `colliding`.
+  /// apart, the result gets one more contact at their exact closest points (World::separation's
+  /// descent, separation.h): point midway, normal from B's closest point toward A's, depth =
+  /// -distance (< 0), errorBound 0, the two triangles as features (ContactFeature::kTriangle).
+  /// It does not set `colliding`.
   /// Not metered by the budget: one exact distance query, which stops as soon as the surfaces
   /// are proven farther apart than the margin, and runs only for answers without penetration.
   /// The contact tree's own samples within contactSampling.marginAbs come in addition. 0: off.

@@ -1435,11 +1435,11 @@ void addToSide(QueryScratch::Impl::PatchSums& q, Vec3& patchNormal, bool sideA, 
 // outward normals are the intersection's), taken about A's inside centroid so that a boundary
 // left open (an open mesh, a concave clip) errs little; the projected area is half the length of
 // the summed area vectors (B's minus A's: equal halves on a closed boundary); both include the
-// triangles wholly inside the other body. Where both sides
-// are curved the projected area is no measure of the contact -- a nut's helical band wraps
-// around the axis and its area vectors nearly cancel -- and, as where the volume is not positive
-// (a boundary far from closed), the depth is the distance along N between the two inside
-// surfaces' centroids: half the lens's thickness for two spheres, as the volume would give.
+// triangles wholly inside the other body. Where both sides are curved the projected area is no
+// measure of the contact -- a nut's helical band wraps around the axis and its area vectors
+// nearly cancel -- and, as where the volume is not positive (a boundary far from closed), the
+// depth is the distance along N between the two inside surfaces' centroids: half the lens's
+// thickness for two spheres, as the volume would give.
 double patchDepth(const QueryScratch::Impl::PatchSums& q, const Vec3& normal, bool curved) {
   const Vec3 origin = q.centroidA / q.areaA;
   const Vec3 vectorA = q.vectorA + q.insideVectorA, vectorB = q.vectorB + q.insideVectorB;
@@ -1456,13 +1456,14 @@ constexpr std::uint32_t kUnseen = 0xffffffffu, kCrossing = 0xfffffffeu, kOutside
 // intersection (a box pressed flat into a floor: its bottom face). Without them a flat
 // penetration's inside surface was its side strips alone, and the depth half the penetration
 // (docs/narrow-phase.md). The normal keeps the crossing pieces alone: with these added too, the
-// nut of tests/scene/nut_bolt_scene_test.cpp turned 0.89 instead of 1.18 turns in its 2 s. From the crossing
-// triangles the flood goes across edges: a triangle that crosses nothing is either wholly inside
-// `other` or wholly outside, and its centroid against the other body's exact field decides,
-// inside only when deeper than `tolerance` -- a triangle lying on the other surface (flush, or
-// touching without crossing) is not inside, and the flood does not leak past it. Only for a
-// finished query (every crossing pair known) against a closed `other`. Each inside triangle joins
-// the patch it was reached from. Cost: one field query per triangle reached.
+// nut of tests/scene/nut_bolt_scene_test.cpp turned 0.89 instead of 1.18 turns in its 2 s.
+// From the crossing triangles of flat patches (curved ones do not use them) the flood goes
+// across edges: a triangle that crosses nothing is either wholly inside `other` or wholly
+// outside, and its centroid against the other body's exact field decides, inside only when
+// deeper than `tolerance` -- a triangle lying on the other surface (flush, or touching without
+// crossing) is not inside, and the flood does not leak past it. Only for a finished query (every
+// crossing pair known) against a closed `other`. Each inside triangle joins the patch it was
+// reached from. Cost: one field query per triangle reached.
 void addWhollyInsideTriangles(const CollisionBody& self, const CollisionBody& other, bool selfIsA,
                               const MatrixPose& otherFromSelf, const MatrixPose& aFromSelf, double tolerance,
                               QueryScratch::Impl& s) {
@@ -1495,7 +1496,8 @@ void addWhollyInsideTriangles(const CollisionBody& self, const CollisionBody& ot
       if (inside) s.floodQueue.push_back(u);
     }
   };
-  for (const auto& p : s.volumePairs) visitNeighbours(selfIsA ? p.ta : p.tb, p.patch);
+  for (const auto& p : s.volumePairs)
+    if (s.patchCurved[p.patch] == 0) visitNeighbours(selfIsA ? p.ta : p.tb, p.patch);
   for (std::size_t i = 0; i < s.floodQueue.size(); ++i) {
     const std::uint32_t u = s.floodQueue[i];
     addTriangle(u, s.triangleState[u]);
@@ -1855,10 +1857,9 @@ void checkSettings(const QuerySettings& s) {
 // QuerySettings::marginAbs: one speculative contact at the exact closest points of two surfaces
 // at most `margin` apart, when no contact of `raw` (world frame) penetrates beyond its error
 // bound (a coarse or sampled contact within its bound of zero may be the bodies about to touch,
-// and is kept beside it). The closest
-// points are the answer every model would converge to for bodies apart, and a pair of points
-// is all a solver needs to stop an approach before it penetrates (Bullet and Box2D keep points
-// within a margin the same way).
+// and is kept beside it). The closest points are the answer every model would converge to for
+// bodies apart, and a pair of points is all a solver needs to stop an approach before it
+// penetrates (Bullet and Box2D keep points within a margin the same way).
 void addSpeculativeContact(const CollisionBody& a, const Pose& xfWorldFromA, const CollisionBody& b,
                            const Pose& xfWorldFromB, double margin, std::uint32_t level,
                            detail::SeparationHeap& heap, std::vector<Contact>& raw) {
