@@ -60,7 +60,8 @@ enum class ContactFeature : std::uint8_t {
   /// by hand).
   kNone = 0,
   /// Triangle indices into the two bodies' meshes (CollisionBody::mesh()): the exact model's
-  /// triangle-triangle intersections; the contact point lies on both triangles.
+  /// contacts. A point on the intersection curve lies on both triangles; a vertex inside the
+  /// other body (flat patches) has contactPointOnA on featureA and contactPointOnB on featureB.
   kTriangle = 1,
   /// Sphere indices into the two bodies' sphere-trees: dos, average and cfm, the exact model's
   /// cfm fallback of an interrupted query and its separating-axis answer between two convex
@@ -110,10 +111,11 @@ struct Contact {
 /// the bodies and holds apart (StepReport::contactPoints, world.h). Where the model's point is
 /// the middle of the penetration -- dos, average and cfm (D&O points, face-clipped corners), and
 /// the exact model's face corners between convex polyhedra -- they are the two surfaces' points
-/// (tested on a box in a box). The exact model's triangle contacts lie on the surfaces'
-/// intersection with the patch's depth, and the contact tree's samples lie on one of the two
-/// surfaces: there the pair is the same penetration centred on the reported point, up to depth / 2
-/// away from the surface points (docs/narrow-phase.md, "Feature ids and both points").
+/// (tested on a box in a box), and the exact model's vertices inside the other body. Its points
+/// on the surfaces' intersection carry their patch's depth, and the contact tree's samples lie
+/// on one of the two surfaces: there the pair is the same penetration centred on the reported
+/// point, up to depth / 2 away from the surface points (docs/narrow-phase.md, "Feature ids and
+/// both points").
 inline Vec3 contactPointOnA(const Contact& c) { return c.point - 0.5 * c.depth * c.normal; }
 inline Vec3 contactPointOnB(const Contact& c) { return c.point + 0.5 * c.depth * c.normal; }
 

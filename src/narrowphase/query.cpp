@@ -15,6 +15,7 @@
 #include "clod/error.h"
 #include "containment.h"
 #include "face_overlap.h"
+#include "ray_cast.h"
 #include "separation.h"
 #include "triangle_intersection.h"
 
@@ -274,6 +275,7 @@ struct QueryScratch::Impl {
   std::vector<std::uint8_t> pairCoplanar;  // per volume pair (insertion order)
   std::vector<Vec3> pairNormalA;           // A's face normal per volume pair, A's frame
   std::vector<Vec3> pairNormalB;           // B's face normal per volume pair, A's frame
+  std::vector<std::uint32_t> pairLevel;    // the sphere-tree level it was found at, per volume pair
   // Per volume pair (insertion order): the inside pieces of its A and of its B triangle (each
   // triangle clipped by the other body's triangles it meets in the patch), A's frame.
   struct Piece {
@@ -307,6 +309,16 @@ struct QueryScratch::Impl {
   // being filled, its state (kUnseen, kCrossing, kOutside or the patch it was reached from), and
   // the triangles touched, to reset them afterwards; the flood's queue.
   std::vector<std::uint32_t> triangleState, touchedTriangles, floodQueue;
+  // Vertex contacts of the exact model (vertexContacts): per vertex of each body whether it was
+  // tried, the vertices tried (to reset), and the contacts found, with their patch.
+  std::vector<std::uint8_t> vertexTriedA, vertexTriedB;
+  std::vector<std::uint32_t> triedA, triedB;
+  struct PatchContact {
+    std::uint32_t patch;
+    Contact contact;
+  };
+  std::vector<PatchContact> vertexContacts;
+  std::vector<std::uint8_t> patchHasVertices;
   std::vector<std::uint32_t> clippers;
   std::vector<Vec3> poly, polyTmp;
   std::vector<Contact> raw;
@@ -1713,6 +1725,100 @@ void localNormal(const QueryScratch::Impl& s, std::uint32_t pair, Contact& c) {
   c.normal = n / len;
 }
 
+// Per-point depth in the exact model: the vertices of either body that lie inside the other,
+// next to a patch, each a contact with its own penetration along the normal line through it --
+// how far it moves along +n before it leaves B plus how far along -n before it leaves A (one ray
+// per body on the triangle hierarchies), the quantity `Contact::errorBound` promises
+// (docs/narrow-phase.md, "Error bounds"), so the bound is 0. Candidates are the vertices of the
+// patch's crossing triangles behind the plane of the triangle they cross: with a penetration
+// shallower than the triangles (a body resting on another) these are the deepest points of the
+// overlap. Where a patch has any, they replace its points on the intersection curve, whose
+// penetration along any line is 0 and which all carried the patch's one depth: a mesh landing
+// tilted on an edge pushed back along the whole edge at its mean depth, where a body touches
+// first at its lowest vertex (docs/narrow-phase.md, "exact"). A patch with none (two edges
+// crossing) keeps its curve points and depth. In a curved patch a vertex takes the local normal of
+// the triangle pair it was found from (localNormal: a thread's flank), with the depth across it.
+// Its two surface points (contactPointOnA / OnB) are where the line leaves each body, on
+// featureA / featureB. Finished queries only, and only vertices inside a closed body (an open
+// body's inside is not defined; the other side may be open: a scanned bunny with holes resting
+// on a box). Cost: up to two rays per candidate vertex.
+void vertexContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const Pose& xfAFromB,
+                    QueryScratch::Impl& s) {
+  const std::size_t patches = s.patchNormal.size();
+  s.vertexContacts.clear();
+  s.patchHasVertices.assign(patches, 0);
+  // A vertex is inside a closed body only: A's vertices need B closed, B's need A closed.
+  const bool tryA = bodyB.isClosed(), tryB = bodyA.isClosed();
+  if ((!tryA && !tryB) || s.volumePairs.empty()) return;
+  const TriangleMesh& ma = bodyA.mesh();
+  const TriangleMesh& mb = bodyB.mesh();
+  const MatrixPose aFromB(xfAFromB);
+  const MatrixPose bFromA(xfAFromB.inverse());
+  const double tMinA = 1e-9 * bodyA.diagonal(), tMinB = 1e-9 * bodyB.diagonal();
+  if (s.vertexTriedA.size() < ma.vertices.size()) s.vertexTriedA.resize(ma.vertices.size(), 0);
+  if (s.vertexTriedB.size() < mb.vertices.size()) s.vertexTriedB.resize(mb.vertices.size(), 0);
+  s.triedA.clear();
+  s.triedB.clear();
+  detail::RayHit exitA, exitB;
+  // p: the vertex in A's frame; insideA / insideB: how far the line runs inside each body.
+  auto addContact = [&](const QueryScratch::Impl::VolumePair& pair, const Vec3& p, double insideA, double insideB,
+                        std::uint32_t featureA, std::uint32_t featureB) {
+    const Vec3& n = s.patchNormal[pair.patch];
+    Contact c;
+    c.point = p + 0.5 * (insideB - insideA) * n;
+    c.normal = n;
+    c.depth = insideA + insideB;
+    if (s.patchCurved[pair.patch] != 0) {
+      localNormal(s, pair.index, c);
+      c.depth *= c.normal.dot(n);  // across the pair's faces rather than along the patch normal
+    }
+    c.errorBound = 0.0;
+    c.level = s.pairLevel[pair.index];
+    c.featureA = featureA;
+    c.featureB = featureB;
+    c.featureKind = ContactFeature::kTriangle;
+    s.vertexContacts.push_back({pair.patch, c});
+    s.patchHasVertices[pair.patch] = 1;
+  };
+  for (const auto& pair : s.volumePairs) {
+    if (s.patchCurved[pair.patch] != 0) continue;
+    const Vec3& n = s.patchNormal[pair.patch];
+    const Vec3 nB = bFromA.rotation * n;
+    // A's vertices behind B's crossing triangle: inside B if the ray along +n leaves B.
+    const Vec3 b0 = aFromB.apply(mb.corner(pair.tb, 0));
+    const Vec3 faceB = aFromB.rotation * mb.triangleNormal(pair.tb);
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t v = ma.triangles[pair.ta][static_cast<std::size_t>(k)];
+      if (!tryA || s.vertexTriedA[v] != 0) continue;
+      const Vec3& p = ma.vertices[v];
+      if (faceB.dot(p - b0) >= 0.0) continue;
+      s.vertexTriedA[v] = 1;
+      s.triedA.push_back(v);
+      const double insideB = detail::distanceToLeave(bodyB, bFromA.apply(p), nB, 0.0, exitB);
+      if (!(insideB > 0.0)) continue;
+      const double insideA = detail::distanceToLeave(bodyA, p, -n, tMinA, exitA);
+      addContact(pair, p, insideA, insideB, insideA > 0.0 ? exitA.triangle : pair.ta, exitB.triangle);
+    }
+    // B's vertices behind A's crossing triangle: inside A if the ray along -n leaves A.
+    const Vec3 a0 = ma.corner(pair.ta, 0);
+    const Vec3 faceA = ma.triangleNormal(pair.ta);
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t v = mb.triangles[pair.tb][static_cast<std::size_t>(k)];
+      if (!tryB || s.vertexTriedB[v] != 0) continue;
+      const Vec3 p = aFromB.apply(mb.vertices[v]);
+      if (faceA.dot(p - a0) >= 0.0) continue;
+      s.vertexTriedB[v] = 1;
+      s.triedB.push_back(v);
+      const double insideA = detail::distanceToLeave(bodyA, p, -n, 0.0, exitA);
+      if (!(insideA > 0.0)) continue;
+      const double insideB = detail::distanceToLeave(bodyB, mb.vertices[v], nB, tMinB, exitB);
+      addContact(pair, p, insideA, insideB, exitA.triangle, insideB > 0.0 ? exitB.triangle : pair.tb);
+    }
+  }
+  for (std::uint32_t v : s.triedA) s.vertexTriedA[v] = 0;
+  for (std::uint32_t v : s.triedB) s.vertexTriedB[v] = 0;
+}
+
 // Returns true if every frontier pair got its triangle tests.
 bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const Pose& xfAFromB,
                    const std::vector<SpherePair>& front, bool traversalFinished, Meter& meter,
@@ -1729,6 +1835,7 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
   s.pairCoplanar.clear();
   s.pairNormalA.clear();
   s.pairNormalB.clear();
+  s.pairLevel.clear();
   hits.clear();
   bool complete = traversalFinished;
   if (traversalFinished) {
@@ -1789,6 +1896,7 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
         s.pairCoplanar.push_back(hit.coplanar ? 1 : 0);
         s.pairNormalA.push_back(hit.normalA);
         s.pairNormalB.push_back(hit.normalB);
+        s.pairLevel.push_back(std::max(bodyA.sphereLevel(front[i].a), bodyB.sphereLevel(front[i].b)));
         // Normal and depth are filled in below, once all intersecting pairs are known.
         const std::uint64_t key = (std::uint64_t{ref.ta} << 32) | ref.tb;
         Contact c;
@@ -1819,8 +1927,16 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
   s.patchParent.resize(s.volumePairs.size());
   for (std::size_t i = 0; i < s.volumePairs.size(); ++i) s.patchParent[i] = s.volumePairs[i].patch;
   penetrationVolumeNormals(bodyA, bodyB, xfAFromB, patches, complete, s);
+  if (complete) {
+    vertexContacts(bodyA, bodyB, xfAFromB, s);
+  } else {
+    s.vertexContacts.clear();
+    s.patchHasVertices.assign(patches, 0);
+  }
+  for (auto& pc : s.vertexContacts) out.push_back(pc.contact);
   for (auto& kc : s.exactContacts) {
     const std::uint32_t patch = s.patchParent[kc.pair];
+    if (s.patchHasVertices[patch] != 0) continue;
     kc.contact.normal = s.patchNormal[patch];
     kc.contact.depth = s.patchDepth[patch];
     if (s.patchCurved[patch] != 0) localNormal(s, kc.pair, kc.contact);

@@ -160,5 +160,39 @@ TEST(ExactModelPatches, NarrowPillarSunkIntoABedGetsTheFullDepth) {
   }
 }
 
+// A cube landing tilted on one bottom edge (turned 10 deg about y, that edge 1 cm into a bed of two
+// boxes in one mesh): the points on the intersection curve run up the tilt to the bed's top, where
+// the penetration along any line is 0, and a patch depth on every one of them (before: the
+// volume over the area, 3.3 mm) pushed back along the whole edge at a third of the real depth. Per
+// point (docs/narrow-phase.md, "exact"): the two vertices of the edge are the contacts, each 1 cm
+// deep, with their surface points on the cube (the vertex) and on the bed's top. Analytic: the
+// cube's bottom vertices at x = +0.5 lie 0.5 (sin + cos) below its centre, the others at least
+// sin 10 deg - 1 cm = 16 cm above the bed. Tolerance as above.
+TEST(ExactModelPatches, CubeLandingOnAnEdgeGetsItsTwoVerticesAtTheirOwnDepth) {
+  TriangleMesh bed;
+  appendMoved(bed, makeBox(Vec3(2.0, 2.0, 0.1)), Vec3(0.0, 0.0, -0.1));
+  appendMoved(bed, makeBox(Vec3(1.0, 1.0, 0.1)), Vec3(5.0, 0.0, -0.1));
+  const CollisionBody bedBody = test::makeTestBody(bed, 2, false, false);
+  const CollisionBody cube = test::makeTestBody(makeBox(Vec3::Constant(0.5)), 2, false, false);
+  const double tilt = 10.0 * kDegree, depth = 0.01;
+  Pose pose;
+  pose.rotation = Quat(Eigen::AngleAxisd(tilt, Vec3::UnitY()));
+  pose.translation = Vec3(0.1, 0.2, 0.5 * (std::sin(tilt) + std::cos(tilt)) - depth);
+  const QueryResult r = queryContacts(bedBody, Pose{}, cube, pose, exactSettings(8));
+  ASSERT_TRUE(r.finished);
+  ASSERT_EQ(r.contacts.size(), 2u);
+  for (const Contact& c : r.contacts) {
+    EXPECT_NEAR(c.depth, depth, kDepthTolerance);
+    EXPECT_EQ(c.errorBound, 0.0);
+    EXPECT_LT(angleBetween(c.normal, -Vec3::UnitZ()), 0.01 * kDegree) << c.normal.transpose();
+    // B is the cube here: its point is the vertex, A's (the bed's) lies on the bed's top.
+    const Vec3 vertex = pose.applyInverse(contactPointOnB(c));
+    EXPECT_NEAR(vertex.x(), 0.5, 1e-9) << vertex.transpose();
+    EXPECT_NEAR(std::abs(vertex.y()), 0.5, 1e-9) << vertex.transpose();
+    EXPECT_NEAR(vertex.z(), -0.5, 1e-9) << vertex.transpose();
+    EXPECT_NEAR(contactPointOnA(c).z(), 0.0, 1e-9) << contactPointOnA(c).transpose();
+  }
+}
+
 }  // namespace
 }  // namespace clod
