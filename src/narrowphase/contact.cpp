@@ -12,6 +12,11 @@
 namespace clod {
 namespace {
 
+// Depths within this fraction of the deepest count as equally deep (reduceManifold): far above
+// rounding (a vertex's depth from two models' arithmetic differed by ~1e-12 relative), far below
+// any depth difference the solver could act on.
+constexpr double kDepthTieRel = 1e-6;
+
 constexpr std::array<ContactModel, 5> kModels = {ContactModel::kDos, ContactModel::kAverage, ContactModel::kCfm,
                                                  ContactModel::kContactTree, ContactModel::kExact};
 
@@ -46,16 +51,31 @@ std::size_t reduceManifold(std::span<Contact> contacts, const ManifoldSettings& 
   const std::size_t n = contacts.size();
   if (n == 0) return 0;
 
-  // Deepest first (first in input order among equals).
-  std::size_t deepest = 0;
+  // Deepest first. Among contacts as deep within kDepthTieRel (a face or an edge lying flat on
+  // another: many equal depths, which differ only by rounding), the one farthest from the
+  // contacts' centroid: an end of the edge, a corner of the face. Before, input order broke
+  // the tie, so two models that found the same vertices of a fandisk's edge lying flat on a box
+  // kept different subsets -- one without the edge's end -- and the drop turned differently.
+  std::size_t strict = 0;
   for (std::size_t i = 1; i < n; ++i) {
-    if (contacts[i].depth > contacts[deepest].depth) deepest = i;
+    if (contacts[i].depth > contacts[strict].depth) strict = i;
   }
-  std::swap(contacts[0], contacts[deepest]);
   // Distances are measured in the contact plane so that contacts stacked along the normal (the
   // same spot seen at different depths) count as one, and spread means spread along the surface.
-  const Vec3 normal = contacts[0].normal;
+  const Vec3 normal = contacts[strict].normal;
   auto planar = [&](const Vec3& d) { return (d - normal.dot(d) * normal).squaredNorm(); };
+  const double tieDepth = contacts[strict].depth - kDepthTieRel * std::abs(contacts[strict].depth);
+  Vec3 centroid = Vec3::Zero();
+  for (std::size_t i = 0; i < n; ++i) centroid += contacts[i].point;
+  centroid /= static_cast<double>(n);
+  std::size_t deepest = strict;
+  double deepestSpread = planar(contacts[strict].point - centroid);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (contacts[i].depth < tieDepth) continue;
+    const double spread = planar(contacts[i].point - centroid);
+    if (spread > deepestSpread) deepest = i, deepestSpread = spread;
+  }
+  std::swap(contacts[0], contacts[deepest]);
 
   scratch.resize(n);
   for (std::size_t i = 1; i < n; ++i) scratch[i] = planar(contacts[i].point - contacts[0].point);

@@ -54,6 +54,27 @@ TEST(ReduceManifold, KeepsTheFourCornersOfARectangleWhoseDeepestContactLiesNearO
   }
 }
 
+TEST(ReduceManifold, KeepsBothEndsOfAnEdgeLyingFlatWhateverTheOrder) {
+  // 29 vertices of an edge lying flat, all equally deep (a fandisk's bottom edge on a box), in
+  // every rotation of their order: both ends are always kept. (Input order broke the depth tie
+  // before: starting from the second vertex, farthest-point sampling never went back 1 cm to the
+  // end, and two models finding the same vertices kept different supports.)
+  std::vector<Contact> edge;
+  for (int i = 0; i <= 28; ++i) edge.push_back(at(0.01 * i, 0.0, 0.001));
+  std::vector<double> scratch;
+  for (std::size_t shift = 0; shift < edge.size(); ++shift) {
+    std::vector<Contact> contacts = edge;
+    std::rotate(contacts.begin(), contacts.begin() + static_cast<std::ptrdiff_t>(shift), contacts.end());
+    const std::size_t n = reduceManifold(contacts, {8, 0.0}, scratch);
+    ASSERT_EQ(n, 8u);
+    for (const double end : {0.0, 0.28}) {
+      double nearest = 1e9;
+      for (std::size_t i = 0; i < n; ++i) nearest = std::min(nearest, std::abs(contacts[i].point.x() - end));
+      EXPECT_LT(nearest, 1e-12) << "end " << end << ", order rotated by " << shift;
+    }
+  }
+}
+
 TEST(ReduceManifold, MergesCoincidentContactsAndMeasuresInTheContactPlane) {
   // Five copies of two spots, stacked along the normal at different depths: two contacts remain.
   std::vector<Contact> contacts;
