@@ -1768,10 +1768,6 @@ void vertexContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, cons
     c.point = p + 0.5 * (insideB - insideA) * n;
     c.normal = n;
     c.depth = insideA + insideB;
-    if (s.patchCurved[pair.patch] != 0) {
-      localNormal(s, pair.index, c);
-      c.depth *= c.normal.dot(n);  // across the pair's faces rather than along the patch normal
-    }
     c.errorBound = 0.0;
     c.level = s.pairLevel[pair.index];
     c.featureA = featureA;
@@ -1780,8 +1776,9 @@ void vertexContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, cons
     s.vertexContacts.push_back({pair.patch, c});
     s.patchHasVertices[pair.patch] = 1;
   };
+  const bool convexSide = bodyA.isConvexPolyhedron() || bodyB.isConvexPolyhedron();
   for (const auto& pair : s.volumePairs) {
-    if (s.patchCurved[pair.patch] != 0) continue;
+    if (s.patchCurved[pair.patch] != 0 && !convexSide) continue;
     const Vec3& n = s.patchNormal[pair.patch];
     const Vec3 nB = bFromA.rotation * n;
     // A's vertices behind B's crossing triangle: inside B if the ray along +n leaves B.

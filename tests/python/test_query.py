@@ -122,13 +122,25 @@ def test_spheres_give_the_centre_line_normal_and_depth(sphere_bake):
     exact = clod.query(sphere_bake, IDENTITY, sphere_bake, pose_b, model="exact")
     assert exact.finished and len(exact) >= 3
     np.testing.assert_allclose(exact.normal @ -axis, 1.0, atol=0.01)
-    # Exact contacts are where the two meshes' triangles cross: on both surfaces (NumPy brute force).
+    # Exact contacts are the vertices of each sphere inside the other (a convex polyhedron:
+    # docs/narrow-phase.md, "exact"), their two points where the normal line leaves each surface
+    # (NumPy brute force), their point midway: on the lens's middle plane.
     mesh = sphere_bake.mesh
     faces = mesh.faces.astype(np.int64)
     tol = 1e-9 * sphere_bake.diagonal
-    np.testing.assert_allclose(brute_force_distance(exact.pos, mesh.vertices, faces), 0.0, atol=tol)
-    np.testing.assert_allclose(brute_force_distance(exact.pos - 1.9 * axis, mesh.vertices, faces), 0.0, atol=tol)
+    np.testing.assert_allclose(brute_force_distance(exact.point_on_a, mesh.vertices, faces), 0.0, atol=tol)
+    np.testing.assert_allclose(brute_force_distance(exact.point_on_b - 1.9 * axis, mesh.vertices, faces), 0.0, atol=tol)
     np.testing.assert_allclose(exact.pos @ axis, 0.95, atol=0.007)
+    # Each depth is the run of its normal line inside both spheres (the analytic chords'
+    # overlap), to the faces' sag inside the sphere (0.007 for two).
+    for point, normal, depth in zip(exact.pos, exact.normal, exact.penetration_depth):
+        runs = []
+        for centre in (np.zeros(3), 1.9 * axis):
+            b = normal @ (point - centre)
+            half = np.sqrt(max(0.0, b * b - ((point - centre) @ (point - centre) - 1.0)))
+            runs.append((-b - half, -b + half))
+        overlap = min(runs[0][1], runs[1][1]) - max(runs[0][0], runs[1][0])
+        assert abs(depth - overlap) <= 0.007, (depth, overlap)
     # The contact tree's deepest contact is the penetration depth to its error bound.
     tree = clod.query(sphere_bake, IDENTITY, sphere_bake, pose_b, model="contact-tree")
     deepest = np.argmax(tree.penetration_depth)
