@@ -61,7 +61,8 @@ enum class ContactFeature : std::uint8_t {
   kNone = 0,
   /// Triangle indices into the two bodies' meshes (CollisionBody::mesh()): the exact model's
   /// contacts. A point on the intersection curve lies on both triangles; a vertex inside the
-  /// other body (flat patches) has contactPointOnA on featureA and contactPointOnB on featureB.
+  /// other body (flat patches, convex polyhedra) has contactPointOnA on featureA and
+  /// contactPointOnB on featureB.
   kTriangle = 1,
   /// Sphere indices into the two bodies' sphere-trees: dos, average and cfm, the exact model's
   /// cfm fallback of an interrupted query and its separating-axis answer between two convex
