@@ -310,14 +310,10 @@ struct QueryScratch::Impl {
   // the triangles touched, to reset them afterwards; the flood's queue.
   std::vector<std::uint32_t> triangleState, touchedTriangles, floodQueue;
   // Vertex contacts of the exact model (vertexContacts): per vertex of each body whether it was
-  // tried, the vertices tried (to reset), and the contacts found, with their patch.
-  std::vector<std::uint8_t> vertexTriedA, vertexTriedB;
-  std::vector<std::uint32_t> triedA, triedB;
-  struct PatchContact {
-    std::uint32_t patch;
-    Contact contact;
-  };
-  std::vector<PatchContact> vertexContacts;
+  // tried, the vertices tried (to reset), the contacts found and the patches that have any.
+  std::array<std::vector<std::uint8_t>, 2> vertexTried;
+  std::array<std::vector<std::uint32_t>, 2> triedVertices;
+  std::vector<Contact> vertexContacts;
   std::vector<std::uint8_t> patchHasVertices;
   std::vector<std::uint32_t> clippers;
   std::vector<Vec3> poly, polyTmp;
@@ -1742,78 +1738,69 @@ void localNormal(const QueryScratch::Impl& s, std::uint32_t pair, Contact& c) {
 // featureA / featureB. Finished queries only, and only vertices inside a closed body (an open
 // body's inside is not defined; the other side may be open: a scanned bunny with holes resting
 // on a box). Cost: up to two rays per candidate vertex.
-void vertexContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const Pose& xfAFromB,
+void vertexContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const Pose& xfAFromB, bool complete,
                     QueryScratch::Impl& s) {
-  const std::size_t patches = s.patchNormal.size();
   s.vertexContacts.clear();
-  s.patchHasVertices.assign(patches, 0);
-  // A vertex is inside a closed body only: A's vertices need B closed, B's need A closed.
-  const bool tryA = bodyB.isClosed(), tryB = bodyA.isClosed();
-  if ((!tryA && !tryB) || s.volumePairs.empty()) return;
-  const TriangleMesh& ma = bodyA.mesh();
-  const TriangleMesh& mb = bodyB.mesh();
+  s.patchHasVertices.assign(s.patchNormal.size(), 0);
+  if (!complete || s.volumePairs.empty()) return;
   const MatrixPose aFromB(xfAFromB);
   const MatrixPose bFromA(xfAFromB.inverse());
-  const double tMinA = 1e-9 * bodyA.diagonal(), tMinB = 1e-9 * bodyB.diagonal();
-  if (s.vertexTriedA.size() < ma.vertices.size()) s.vertexTriedA.resize(ma.vertices.size(), 0);
-  if (s.vertexTriedB.size() < mb.vertices.size()) s.vertexTriedB.resize(mb.vertices.size(), 0);
-  s.triedA.clear();
-  s.triedB.clear();
-  detail::RayHit exitA, exitB;
-  // p: the vertex in A's frame; insideA / insideB: how far the line runs inside each body.
-  auto addContact = [&](const QueryScratch::Impl::VolumePair& pair, const Vec3& p, double insideA, double insideB,
-                        std::uint32_t featureA, std::uint32_t featureB) {
-    const Vec3& n = s.patchNormal[pair.patch];
-    Contact c;
-    c.point = p + 0.5 * (insideB - insideA) * n;
-    c.normal = n;
-    c.depth = insideA + insideB;
-    c.errorBound = 0.0;
-    c.level = s.pairLevel[pair.index];
-    c.featureA = featureA;
-    c.featureB = featureB;
-    c.featureKind = ContactFeature::kTriangle;
-    s.vertexContacts.push_back({pair.patch, c});
-    s.patchHasVertices[pair.patch] = 1;
-  };
+  const MatrixPose identity{Pose{}};
   const bool convexSide = bodyA.isConvexPolyhedron() || bodyB.isConvexPolyhedron();
-  for (const auto& pair : s.volumePairs) {
-    if (s.patchCurved[pair.patch] != 0 && !convexSide) continue;
+  detail::RayHit exitA, exitB;
+  // The vertices of one side's triangle of `pair` behind the other side's triangle, each a
+  // contact if the line along the patch normal leaves the other body (A's vertices go along +n
+  // into B, B's along -n into A). A vertex is inside a closed body only.
+  auto trySide = [&](const QueryScratch::Impl::VolumePair& pair, bool sideA) {
+    const CollisionBody& self = sideA ? bodyA : bodyB;
+    const CollisionBody& other = sideA ? bodyB : bodyA;
+    if (!other.isClosed()) return;
+    const TriangleMesh& mesh = self.mesh();
+    const TriangleMesh& otherMesh = other.mesh();
+    const MatrixPose& aFromSelf = sideA ? identity : aFromB;
+    const MatrixPose& aFromOther = sideA ? aFromB : identity;
+    const std::uint32_t own = sideA ? pair.ta : pair.tb, crossed = sideA ? pair.tb : pair.ta;
+    const Vec3 c0 = aFromOther.apply(otherMesh.corner(crossed, 0));
+    const Vec3 crossedNormal = aFromOther.rotation * otherMesh.triangleNormal(crossed);
     const Vec3& n = s.patchNormal[pair.patch];
     const Vec3 nB = bFromA.rotation * n;
-    // A's vertices behind B's crossing triangle: inside B if the ray along +n leaves B.
-    const Vec3 b0 = aFromB.apply(mb.corner(pair.tb, 0));
-    const Vec3 faceB = aFromB.rotation * mb.triangleNormal(pair.tb);
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t v = ma.triangles[pair.ta][static_cast<std::size_t>(k)];
-      if (!tryA || s.vertexTriedA[v] != 0) continue;
-      const Vec3& p = ma.vertices[v];
-      if (faceB.dot(p - b0) >= 0.0) continue;
-      s.vertexTriedA[v] = 1;
-      s.triedA.push_back(v);
-      const double insideB = detail::distanceToLeave(bodyB, bFromA.apply(p), nB, 0.0, exitB);
-      if (!(insideB > 0.0)) continue;
-      const double insideA = detail::distanceToLeave(bodyA, p, -n, tMinA, exitA);
-      addContact(pair, p, insideA, insideB, insideA > 0.0 ? exitA.triangle : pair.ta, exitB.triangle);
+    auto& tried = s.vertexTried[sideA ? 0 : 1];
+    if (tried.size() < mesh.vertices.size()) tried.resize(mesh.vertices.size(), 0);
+    for (const std::uint32_t v : mesh.triangles[own]) {
+      const Vec3 p = aFromSelf.apply(mesh.vertices[v]);
+      if (tried[v] != 0 || crossedNormal.dot(p - c0) >= 0.0) continue;
+      tried[v] = 1;
+      s.triedVertices[sideA ? 0 : 1].push_back(v);
+      // First into the other body; then its own, which it leaves at once unless the line runs
+      // into it (the triangles at p itself are skipped).
+      auto intoB = [&](double tMin) { return detail::distanceToLeave(bodyB, bFromA.apply(p), nB, tMin, exitB); };
+      auto intoA = [&](double tMin) { return detail::distanceToLeave(bodyA, p, -n, tMin, exitA); };
+      const double inOther = sideA ? intoB(0.0) : intoA(0.0);
+      if (!(inOther > 0.0)) continue;
+      const double inSelf = sideA ? intoA(1e-9 * bodyA.diagonal()) : intoB(1e-9 * bodyB.diagonal());
+      const double insideA = sideA ? inSelf : inOther, insideB = sideA ? inOther : inSelf;
+      Contact c;
+      c.point = p + 0.5 * (insideB - insideA) * n;
+      c.normal = n;
+      c.depth = insideA + insideB;
+      c.errorBound = 0.0;
+      c.level = s.pairLevel[pair.index];
+      c.featureA = insideA > 0.0 || !sideA ? exitA.triangle : own;
+      c.featureB = insideB > 0.0 || sideA ? exitB.triangle : own;
+      c.featureKind = ContactFeature::kTriangle;
+      s.vertexContacts.push_back(c);
+      s.patchHasVertices[pair.patch] = 1;
     }
-    // B's vertices behind A's crossing triangle: inside A if the ray along -n leaves A.
-    const Vec3 a0 = ma.corner(pair.ta, 0);
-    const Vec3 faceA = ma.triangleNormal(pair.ta);
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t v = mb.triangles[pair.tb][static_cast<std::size_t>(k)];
-      if (!tryB || s.vertexTriedB[v] != 0) continue;
-      const Vec3 p = aFromB.apply(mb.vertices[v]);
-      if (faceA.dot(p - a0) >= 0.0) continue;
-      s.vertexTriedB[v] = 1;
-      s.triedB.push_back(v);
-      const double insideA = detail::distanceToLeave(bodyA, p, -n, 0.0, exitA);
-      if (!(insideA > 0.0)) continue;
-      const double insideB = detail::distanceToLeave(bodyB, mb.vertices[v], nB, tMinB, exitB);
-      addContact(pair, p, insideA, insideB, exitA.triangle, insideB > 0.0 ? exitB.triangle : pair.tb);
-    }
+  };
+  for (const auto& pair : s.volumePairs) {
+    if (s.patchCurved[pair.patch] != 0 && !convexSide) continue;
+    trySide(pair, true);
+    trySide(pair, false);
   }
-  for (std::uint32_t v : s.triedA) s.vertexTriedA[v] = 0;
-  for (std::uint32_t v : s.triedB) s.vertexTriedB[v] = 0;
+  for (int side = 0; side < 2; ++side) {
+    for (std::uint32_t v : s.triedVertices[side]) s.vertexTried[side][v] = 0;
+    s.triedVertices[side].clear();
+  }
 }
 
 // Returns true if every frontier pair got its triangle tests.
@@ -1924,13 +1911,8 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
   s.patchParent.resize(s.volumePairs.size());
   for (std::size_t i = 0; i < s.volumePairs.size(); ++i) s.patchParent[i] = s.volumePairs[i].patch;
   penetrationVolumeNormals(bodyA, bodyB, xfAFromB, patches, complete, s);
-  if (complete) {
-    vertexContacts(bodyA, bodyB, xfAFromB, s);
-  } else {
-    s.vertexContacts.clear();
-    s.patchHasVertices.assign(patches, 0);
-  }
-  for (auto& pc : s.vertexContacts) out.push_back(pc.contact);
+  vertexContacts(bodyA, bodyB, xfAFromB, complete, s);
+  out.insert(out.end(), s.vertexContacts.begin(), s.vertexContacts.end());
   for (auto& kc : s.exactContacts) {
     const std::uint32_t patch = s.patchParent[kc.pair];
     if (s.patchHasVertices[patch] != 0) continue;
