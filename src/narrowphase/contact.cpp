@@ -64,6 +64,16 @@ std::size_t reduceManifold(std::span<Contact> contacts, const ManifoldSettings& 
   // same spot seen at different depths) count as one, and spread means spread along the surface.
   const Vec3 normal = contacts[strict].normal;
   auto planar = [&](const Vec3& d) { return (d - normal.dot(d) * normal).squaredNorm(); };
+  // Two contacts one spot apart in that plane are one spot only if both face it (within 45
+  // deg): a face's contacts beside a deeper one on a perpendicular face (a cube on a slab with a
+  // block pressing its side) lie on one line along the deeper normal yet are opposite corners of
+  // the face. The squared distance that decides it: in the plane, or whole where either turns away.
+  constexpr double kSamePlaneCos = 0.70710678118654752;
+  auto apart = [&](std::size_t i, std::size_t k) {
+    const Vec3 d = contacts[i].point - contacts[k].point;
+    const bool facing = contacts[i].normal.dot(normal) >= kSamePlaneCos && contacts[k].normal.dot(normal) >= kSamePlaneCos;
+    return facing ? planar(d) : d.squaredNorm();
+  };
   const double tieDepth = contacts[strict].depth - kDepthTieRel * std::abs(contacts[strict].depth);
   Vec3 centroid = Vec3::Zero();
   for (std::size_t i = 0; i < n; ++i) centroid += contacts[i].point;
@@ -94,17 +104,24 @@ std::size_t reduceManifold(std::span<Contact> contacts, const ManifoldSettings& 
   };
   // The index of the largest score among the not-kept contacts farther than the merge distance
   // from every kept one (n: none with a positive score).
+  // (A contact within the merge distance of a kept one in the plane is looked at again with
+  // `apart`, and scored by that distance if it is no duplicate.)
   auto best = [&](auto score) {
     std::size_t chosen = n;
     double top = 0.0;
     for (std::size_t i = kept; i < n; ++i) {
-      if (scratch[i] <= mergeSquared) continue;
-      const double value = score(i);
+      double distance = scratch[i];
+      if (distance <= mergeSquared) {
+        distance = std::numeric_limits<double>::infinity();
+        for (std::size_t k = 0; k < kept; ++k) distance = std::min(distance, apart(i, k));
+        if (distance <= mergeSquared) continue;
+      }
+      const double value = score(i, distance);
       if (value > top) top = value, chosen = i;
     }
     return chosen;
   };
-  auto farthest = [&](std::size_t i) { return scratch[i]; };
+  auto farthest = [](std::size_t, double distance) { return distance; };
   if (kept < settings.maxContacts && kept < n) {
     const std::size_t second = best(farthest);
     if (second < n) keep(second);
@@ -117,7 +134,8 @@ std::size_t reduceManifold(std::span<Contact> contacts, const ManifoldSettings& 
     const Vec3 p0 = contacts[0].point, axis = contacts[1].point - p0;
     for (double side : {1.0, -1.0}) {
       if (kept >= settings.maxContacts) break;
-      const std::size_t chosen = best([&](std::size_t i) { return side * axis.cross(contacts[i].point - p0).dot(normal); });
+      const std::size_t chosen =
+          best([&](std::size_t i, double) { return side * axis.cross(contacts[i].point - p0).dot(normal); });
       if (chosen < n) keep(chosen);
     }
   }

@@ -1514,6 +1514,27 @@ void addWhollyInsideTriangles(const CollisionBody& self, const CollisionBody& ot
   for (std::uint32_t t : s.touchedTriangles) s.triangleState[t] = kUnseen;
 }
 
+// A patch's normal where one side of it is a single plane (its pieces' area vectors all point one
+// way: a box's face, a tessellated floor): that plane's normal. The overlap of a body with a
+// half-space separates along the plane's normal by its deepest point's depth and along any other
+// direction u only by more (depth / (u . n)), and the divergence theorem gives the same normal
+// from the two sides' sum when the overlap's boundary is complete -- but a finely tessellated
+// body's triangles wholly inside the other cross nothing and are missing from the sum, which then
+// leans toward that body's faces (a fandisk landing on one edge on a box: 6 deg). Where both sides
+// are planes and not parallel (two triangles crossing at an edge), or neither is, the sum
+// (`summed`, unnormalised) stays.
+Vec3 planeSideNormal(const QueryScratch::Impl::PatchSums& q, const Vec3& summed) {
+  constexpr double kCoplanarCos = 0.99999998476913;  // cos 0.01 deg: rounding, not a bend
+  const bool planeA = q.absoluteA > 0.0 && q.vectorA.norm() >= kCoplanarCos * q.absoluteA;
+  const bool planeB = q.absoluteB > 0.0 && q.vectorB.norm() >= kCoplanarCos * q.absoluteB;
+  const Vec3 fromA = planeA ? Vec3(-q.vectorA.normalized()) : Vec3::Zero();
+  const Vec3 fromB = planeB ? Vec3(q.vectorB.normalized()) : Vec3::Zero();
+  if (planeA && planeB) return fromA.dot(fromB) >= kCoplanarCos ? fromA : summed;
+  if (planeA) return fromA;
+  if (planeB) return fromB;
+  return summed;
+}
+
 // Normal and depth of every patch (s.patchNormal, s.patchDepth), each from its own pairs only:
 // a triangle is clipped by the half-spaces of the other body's triangles it meets in that patch.
 // A patch whose area vectors cancel keeps B's face normal of its first pair (B toward A).
@@ -1595,8 +1616,9 @@ void penetrationVolumeNormals(const CollisionBody& bodyA, const CollisionBody& b
     addWhollyInsideTriangles(bodyB, bodyA, false, aFromB, aFromB, tolerance, s);
   }
   for (std::uint32_t p = 0; p < patchCount; ++p) {
-    const double len = s.patchNormal[p].norm();
     const auto& q = sums[p];
+    s.patchNormal[p] = planeSideNormal(q, s.patchNormal[p]);
+    const double len = s.patchNormal[p].norm();
     s.patchNormal[p] = len > 0.0 ? Vec3(s.patchNormal[p] / len) : q.fallbackNormal;
     if (q.areaA > 0.0 && q.areaB > 0.0) {
       s.patchDepth[p] = patchDepth(q, s.patchNormal[p], s.patchCurved[p] != 0);

@@ -5,7 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <map>
+#include <utility>
+#include <vector>
 
 #include "clod/primitives.h"
 #include "clod/query.h"
@@ -24,6 +28,30 @@ void appendMoved(TriangleMesh& mesh, const TriangleMesh& part, const Vec3& offse
   const auto base = mesh.vertexCount();
   for (const Vec3& v : part.vertices) mesh.vertices.push_back(v + offset);
   for (const Triangle& t : part.triangles) mesh.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+}
+
+// `mesh` with every triangle split into four at its edges' midpoints, `levels` times; a midpoint
+// is shared by the two triangles of its edge, so a closed mesh stays closed.
+TriangleMesh subdivided(TriangleMesh mesh, int levels) {
+  for (int level = 0; level < levels; ++level) {
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> midpoints;
+    auto midpoint = [&](std::uint32_t i, std::uint32_t j) {
+      const auto key = std::minmax(i, j);
+      const auto [it, added] = midpoints.try_emplace(key, static_cast<std::uint32_t>(mesh.vertices.size()));
+      if (added) mesh.vertices.push_back(0.5 * (mesh.vertices[i] + mesh.vertices[j]));
+      return it->second;
+    };
+    std::vector<Triangle> finer;
+    for (const Triangle& t : mesh.triangles) {
+      const std::uint32_t a = midpoint(t[0], t[1]), b = midpoint(t[1], t[2]), c = midpoint(t[2], t[0]);
+      finer.push_back({t[0], a, c});
+      finer.push_back({a, t[1], b});
+      finer.push_back({c, b, t[2]});
+      finer.push_back({a, b, c});
+    }
+    mesh.triangles = std::move(finer);
+  }
+  return mesh;
 }
 
 // Scene (B at the origin): slab |x|, |y| <= 3, -1 <= z <= 0; block 0.4 x 0.4 x 0.4 at
@@ -192,6 +220,39 @@ TEST(ExactModelPatches, CubeLandingOnAnEdgeGetsItsTwoVerticesAtTheirOwnDepth) {
     EXPECT_NEAR(vertex.z(), -0.5, 1e-9) << vertex.transpose();
     EXPECT_NEAR(contactPointOnA(c).z(), 0.0, 1e-9) << contactPointOnA(c).transpose();
   }
+}
+
+// The same landing with the cube finely tessellated (3,072 triangles, legs of 1/16 of its edge):
+// some of its triangles along the edge now lie wholly inside the bed, cross nothing, and their
+// pieces are missing from the crossing pieces' area-vector sum, which then leans toward the
+// cube's bottom face (before: 4 deg off; a fandisk landing on a box on one edge got normals 6 deg
+// off the box's face). The bed's side of the patch is one plane, and the overlap of a body with
+// a half-space is separated along the plane's normal by the deepest point's depth in no other
+// direction by less (every other direction u needs depth / (u . n)): the normal is the face's.
+// Analytic: the edge's vertices, 2 cm deep, at x = 0.5 of the cube; the face normal -z (B, the
+// cube, lies above A, the bed).
+TEST(ExactModelPatches, FinelyTessellatedCubeLandingOnAnEdgeGetsTheBedsFaceNormal) {
+  TriangleMesh bed;
+  appendMoved(bed, makeBox(Vec3(2.0, 2.0, 0.1)), Vec3(0.0, 0.0, -0.1));
+  appendMoved(bed, makeBox(Vec3(1.0, 1.0, 0.1)), Vec3(5.0, 0.0, -0.1));
+  const CollisionBody bedBody = test::makeTestBody(bed, 2, false, false);
+  const CollisionBody cube = test::makeTestBody(subdivided(makeBox(Vec3::Constant(0.5)), 4), 3, false, false);
+  const double tilt = 10.0 * kDegree, depth = 0.02;
+  Pose pose;
+  pose.rotation = Quat(Eigen::AngleAxisd(tilt, Vec3::UnitY()));
+  pose.translation = Vec3(0.1, 0.2, 0.5 * (std::sin(tilt) + std::cos(tilt)) - depth);
+  const QueryResult r = queryContacts(bedBody, Pose{}, cube, pose, exactSettings(64));
+  ASSERT_TRUE(r.finished);
+  ASSERT_FALSE(r.contacts.empty());
+  double deepest = 0.0;
+  for (const Contact& c : r.contacts) {
+    EXPECT_LT(angleBetween(c.normal, -Vec3::UnitZ()), 0.01 * kDegree) << c.normal.transpose();
+    // Each contact is a vertex of the cube at its own depth below the bed's top (tolerance as above).
+    const Vec3 vertex = pose.applyInverse(contactPointOnB(c));
+    EXPECT_NEAR(c.depth, -pose.apply(vertex).z(), kDepthTolerance) << vertex.transpose();
+    deepest = std::max(deepest, c.depth);
+  }
+  EXPECT_NEAR(deepest, depth, kDepthTolerance);
 }
 
 }  // namespace

@@ -91,6 +91,22 @@ TEST(ReduceManifold, MergesCoincidentContactsAndMeasuresInTheContactPlane) {
   EXPECT_NEAR(contacts[1].point.x(), 1.0, 1e-15);
 }
 
+// A floor's contacts beside a deeper one on a wall (a cube on a slab with a block pressing its
+// side, normals +z and -x): the floor's two corners at x = -1 and x = +1 lie on one line along
+// the wall's normal, one spot in its plane, but they are opposite corners of the floor contact,
+// 2 apart: both stay (before, the farther corner was merged away as a duplicate). Contacts
+// stacked along the normal of a face they lie on still merge (the test above).
+TEST(ReduceManifold, KeepsAFaceCornersThatLineUpAlongAPerpendicularDeeperNormal) {
+  Contact wall = at(1.0, 0.0, 0.04);
+  wall.point.z() = 0.5;
+  wall.normal = -Vec3::UnitX();
+  std::vector<Contact> contacts = {wall, at(1.0, 1.0, 0.01), at(-1.0, 1.0, 0.01)};
+  std::vector<double> scratch;
+  ASSERT_EQ(reduceManifold(contacts, {8, 1e-3}, scratch), 3u);
+  EXPECT_EQ(contacts[0].normal, -Vec3::UnitX());
+  EXPECT_NEAR(std::abs(contacts[1].point.x() - contacts[2].point.x()), 2.0, 1e-15);
+}
+
 TEST(ReduceManifold, RejectsBadSettings) {
   std::vector<Contact> contacts{at(0, 0, 0)};
   std::vector<double> scratch;
