@@ -87,8 +87,11 @@ std::size_t reduceManifold(std::span<Contact> contacts, const ManifoldSettings& 
   }
   std::swap(contacts[0], contacts[deepest]);
 
-  scratch.resize(n);
-  for (std::size_t i = 1; i < n; ++i) scratch[i] = planar(contacts[i].point - contacts[0].point);
+  // scratch[i]: squared planar distance of contact i to the kept set (the scores);
+  // scratch[n + i]: its squared `apart` distance (whether it merges into a kept one).
+  scratch.resize(2 * n);
+  double* whole = scratch.data() + n;
+  for (std::size_t i = 1; i < n; ++i) scratch[i] = planar(contacts[i].point - contacts[0].point), whole[i] = apart(i, 0);
   const double mergeSquared = settings.mergeDistanceAbs * settings.mergeDistanceAbs;
   std::size_t kept = 1;
   // Moves contact `chosen` into the kept prefix and lowers the others' distances to the kept set.
@@ -97,25 +100,23 @@ std::size_t reduceManifold(std::span<Contact> contacts, const ManifoldSettings& 
     // chosen one into place (ties were resolved by input order in the scans).
     std::swap(contacts[kept], contacts[chosen]);
     std::swap(scratch[kept], scratch[chosen]);
+    std::swap(whole[kept], whole[chosen]);
     for (std::size_t i = kept + 1; i < n; ++i) {
       scratch[i] = std::min(scratch[i], planar(contacts[i].point - contacts[kept].point));
+      whole[i] = std::min(whole[i], apart(i, kept));
     }
     ++kept;
   };
   // The index of the largest score among the not-kept contacts farther than the merge distance
   // from every kept one (n: none with a positive score).
-  // (A contact within the merge distance of a kept one in the plane is looked at again with
-  // `apart`, and scored by that distance if it is no duplicate.)
+  // (A contact within the merge distance of a kept one in the plane but no duplicate by `apart`
+  // is scored by its `apart` distance.)
   auto best = [&](auto score) {
     std::size_t chosen = n;
     double top = 0.0;
     for (std::size_t i = kept; i < n; ++i) {
-      double distance = scratch[i];
-      if (distance <= mergeSquared) {
-        distance = std::numeric_limits<double>::infinity();
-        for (std::size_t k = 0; k < kept; ++k) distance = std::min(distance, apart(i, k));
-        if (distance <= mergeSquared) continue;
-      }
+      if (whole[i] <= mergeSquared) continue;
+      const double distance = scratch[i] <= mergeSquared ? whole[i] : scratch[i];
       const double value = score(i, distance);
       if (value > top) top = value, chosen = i;
     }
@@ -147,8 +148,8 @@ std::size_t reduceManifold(std::span<Contact> contacts, const ManifoldSettings& 
   if (settings.poolNormalsCos <= 1.0 && kept < n) {
     // scratch[kept .. n) are free (distances of the not-kept contacts are recomputed per kept
     // contact below); the sums go after them: 4 doubles per kept contact (x, y, z, weight).
-    scratch.resize(n + 4 * kept);
-    double* sums = scratch.data() + n;
+    scratch.resize(2 * n + 4 * kept);
+    double* sums = scratch.data() + 2 * n;
     for (std::size_t k = 0; k < kept; ++k) {
       const double w = std::max(contacts[k].depth, 0.0);
       sums[4 * k + 0] = w * contacts[k].normal.x();

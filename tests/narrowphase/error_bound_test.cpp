@@ -207,7 +207,7 @@ TEST(ErrorBound, DepthWithinItsBoundOfThePenetrationAlongTheNormal) {
   }
   expectRate("sphere contact-tree unlimited", 0.9);
   // The exact model's vertex contacts (convex polyhedra on a side: two icospheres, the box on
-  // spot): 100.0 % of 8,387 and 96.3 % of 12,383 over 1,700 poses per pair.
+  // spot): 100.0 % of 8,387 and 96.2 % of 12,383 over 1,700 poses per pair.
   expectRate("sphere exact unlimited", 0.9);
   expectRate("box/spot exact unlimited", 0.9);
 }

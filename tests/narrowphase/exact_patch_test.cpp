@@ -188,6 +188,28 @@ TEST(ExactModelPatches, NarrowPillarSunkIntoABedGetsTheFullDepth) {
   }
 }
 
+// A bed of two boxes in one mesh (so not one convex body): a 4 x 4 x 0.2 slab with its top at
+// z = 0 and a smaller one beside it.
+const CollisionBody& bed() {
+  static const CollisionBody body = [] {
+    TriangleMesh mesh;
+    appendMoved(mesh, makeBox(Vec3(2.0, 2.0, 0.1)), Vec3(0.0, 0.0, -0.1));
+    appendMoved(mesh, makeBox(Vec3(1.0, 1.0, 0.1)), Vec3(5.0, 0.0, -0.1));
+    return test::makeTestBody(mesh, 2, false, false);
+  }();
+  return body;
+}
+
+// A unit cube (half extent 0.5) turned 10 deg about y, its lowest edge (x = +0.5, z = -0.5 of the
+// cube) `depth` into the bed's top.
+Pose cubeOnItsEdge(double depth) {
+  const double tilt = 10.0 * kDegree;
+  Pose pose;
+  pose.rotation = Quat(Eigen::AngleAxisd(tilt, Vec3::UnitY()));
+  pose.translation = Vec3(0.1, 0.2, 0.5 * (std::sin(tilt) + std::cos(tilt)) - depth);
+  return pose;
+}
+
 // A cube landing tilted on one bottom edge (turned 10 deg about y, that edge 1 cm into a bed of two
 // boxes in one mesh): the points on the intersection curve run up the tilt to the bed's top, where
 // the penetration along any line is 0, and a patch depth on every one of them (before: the
@@ -197,16 +219,10 @@ TEST(ExactModelPatches, NarrowPillarSunkIntoABedGetsTheFullDepth) {
 // cube's bottom vertices at x = +0.5 lie 0.5 (sin + cos) below its centre, the others at least
 // sin 10 deg - 1 cm = 16 cm above the bed. Tolerance as above.
 TEST(ExactModelPatches, CubeLandingOnAnEdgeGetsItsTwoVerticesAtTheirOwnDepth) {
-  TriangleMesh bed;
-  appendMoved(bed, makeBox(Vec3(2.0, 2.0, 0.1)), Vec3(0.0, 0.0, -0.1));
-  appendMoved(bed, makeBox(Vec3(1.0, 1.0, 0.1)), Vec3(5.0, 0.0, -0.1));
-  const CollisionBody bedBody = test::makeTestBody(bed, 2, false, false);
+  const double depth = 0.01;
   const CollisionBody cube = test::makeTestBody(makeBox(Vec3::Constant(0.5)), 2, false, false);
-  const double tilt = 10.0 * kDegree, depth = 0.01;
-  Pose pose;
-  pose.rotation = Quat(Eigen::AngleAxisd(tilt, Vec3::UnitY()));
-  pose.translation = Vec3(0.1, 0.2, 0.5 * (std::sin(tilt) + std::cos(tilt)) - depth);
-  const QueryResult r = queryContacts(bedBody, Pose{}, cube, pose, exactSettings(8));
+  const Pose pose = cubeOnItsEdge(depth);
+  const QueryResult r = queryContacts(bed(), Pose{}, cube, pose, exactSettings(8));
   ASSERT_TRUE(r.finished);
   ASSERT_EQ(r.contacts.size(), 2u);
   for (const Contact& c : r.contacts) {
@@ -232,16 +248,10 @@ TEST(ExactModelPatches, CubeLandingOnAnEdgeGetsItsTwoVerticesAtTheirOwnDepth) {
 // Analytic: the edge's vertices, 2 cm deep, at x = 0.5 of the cube; the face normal -z (B, the
 // cube, lies above A, the bed).
 TEST(ExactModelPatches, FinelyTessellatedCubeLandingOnAnEdgeGetsTheBedsFaceNormal) {
-  TriangleMesh bed;
-  appendMoved(bed, makeBox(Vec3(2.0, 2.0, 0.1)), Vec3(0.0, 0.0, -0.1));
-  appendMoved(bed, makeBox(Vec3(1.0, 1.0, 0.1)), Vec3(5.0, 0.0, -0.1));
-  const CollisionBody bedBody = test::makeTestBody(bed, 2, false, false);
+  const double depth = 0.02;
   const CollisionBody cube = test::makeTestBody(subdivided(makeBox(Vec3::Constant(0.5)), 4), 3, false, false);
-  const double tilt = 10.0 * kDegree, depth = 0.02;
-  Pose pose;
-  pose.rotation = Quat(Eigen::AngleAxisd(tilt, Vec3::UnitY()));
-  pose.translation = Vec3(0.1, 0.2, 0.5 * (std::sin(tilt) + std::cos(tilt)) - depth);
-  const QueryResult r = queryContacts(bedBody, Pose{}, cube, pose, exactSettings(64));
+  const Pose pose = cubeOnItsEdge(depth);
+  const QueryResult r = queryContacts(bed(), Pose{}, cube, pose, exactSettings(64));
   ASSERT_TRUE(r.finished);
   ASSERT_FALSE(r.contacts.empty());
   double deepest = 0.0;
