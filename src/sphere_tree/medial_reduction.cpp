@@ -6,6 +6,7 @@
 #include <limits>
 #include <numbers>
 #include <queue>
+#include <span>
 #include <unordered_map>
 #include <utility>
 
@@ -164,19 +165,28 @@ Fitted fitSummary(const Summary& s, std::vector<Vec3>& scratch) {
   const Vec3 medial = s.medialCenter();
   Fitted best;
   best.fit = std::numeric_limits<double>::infinity();
+  double bestWorst = std::numeric_limits<double>::infinity();  // best.fit squared
   for (int c = 0; c < 3; ++c) {
     Sphere sphere;
     sphere.center = smallest.center + 0.5 * c * (medial - smallest.center);
     sphere.radius = c == 0 ? smallest.radius : farthestDistance(sphere.center, points);
+    // max over directions of min over points; both loops stop once the answer cannot change:
+    // a point nearer than the worst so far settles a direction, a worst beyond the best centre's
+    // rules this centre out (the same spheres and fits as the full loops, at a fraction of the cost).
     double worst = 0.0;
     for (const Vec3& d : fitDirections()) {
       const Vec3 q = sphere.center + sphere.radius * d;
       double nearest = std::numeric_limits<double>::infinity();
-      for (const Vec3& p : points) nearest = std::min(nearest, (p - q).squaredNorm());
+      for (const Vec3& p : points) {
+        nearest = std::min(nearest, (p - q).squaredNorm());
+        if (nearest <= worst) break;
+      }
       worst = std::max(worst, nearest);
+      if (worst >= bestWorst) break;
     }
-    const double fit = std::sqrt(worst);
-    if (fit < best.fit) best = {sphere, fit};
+    if (worst >= bestWorst) continue;
+    bestWorst = worst;
+    best = {sphere, std::sqrt(worst)};
   }
   return best;
 }
@@ -461,11 +471,16 @@ private:
     // Hand the summary points to the neighbours, as the burst would hand the pieces.
     std::array<Vec3, kSummaryPoints> pts;
     const int n = cluster.summary.points(pts);
-    std::vector<std::pair<std::uint32_t, Vec3>> handed;
-    handed.reserve(static_cast<std::size_t>(n));
-    for (int i = 0; i < n; ++i) handed.emplace_back(receiverOf(cluster, pts[i]), pts[i]);
-    std::stable_sort(handed.begin(), handed.end(),
-                     [](const auto& x, const auto& y) { return x.first < y.first; });
+    // (receiver, point) grouped by receiver, in point order within a group: an insertion sort
+    // on the stack (at most kSummaryPoints entries; this runs for every cluster change).
+    std::array<std::pair<std::uint32_t, Vec3>, kSummaryPoints> handedStore;
+    const std::span<std::pair<std::uint32_t, Vec3>> handed(handedStore.data(), static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      const std::pair<std::uint32_t, Vec3> entry(receiverOf(cluster, pts[i]), pts[i]);
+      int k = i;
+      for (; k > 0 && handedStore[k - 1].first > entry.first; --k) handedStore[k] = handedStore[k - 1];
+      handedStore[k] = entry;
+    }
     double cost = 0.0;
     for (std::size_t i = 0; i < handed.size();) {
       std::size_t j = i;

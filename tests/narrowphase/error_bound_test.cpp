@@ -105,10 +105,10 @@ struct Tally {
 };
 
 TEST(ErrorBound, DepthWithinItsBoundOfThePenetrationAlongTheNormal) {
-  // Under the sanitizers 6 poses per pair run every model's code path; the rates below are
+  // Under the sanitizers 2 poses per pair run every model's code path; the rates below are
   // statistics of 25 and more, asserted in Release only (tests/support/test_scale.h).
   const int poses = std::getenv("CLOD_ERROR_BOUND_POSES") ? std::atoi(std::getenv("CLOD_ERROR_BOUND_POSES"))
-                                                          : (test::sanitizerRun() ? 6 : 25);
+                                                          : (test::sanitizerRun() ? 2 : 25);
   std::vector<Shape> shapes;
   shapes.push_back(makeShape("box", makeBox(Vec3::Constant(0.5))));
   shapes.push_back(makeShape("sphere", makeIcosphere(0.5, 2)));

@@ -2,6 +2,8 @@
 // Bodies baked in-process for the narrow-phase tests (small trees, to keep the tests fast).
 
 #include <cstdlib>
+#include <map>
+#include <mutex>
 #include <random>
 #include <string>
 
@@ -21,8 +23,8 @@ namespace clod::test {
 /// (16 root stacks: finer than the paper's 10 so the sphere tests' tolerances stay small) and
 /// contact tree (errorRel 2e-3). The map and the tree are the expensive parts (most of the
 /// suite's time under the sanitizers): tests that do not use them leave them out.
-inline CollisionBody makeTestBody(const TriangleMesh& mesh, std::uint32_t depth, bool withContactTree = true,
-                                  bool withClosestFeatureMap = true) {
+inline CollisionBody buildTestBody(const TriangleMesh& mesh, std::uint32_t depth, bool withContactTree,
+                                   bool withClosestFeatureMap) {
   BakeSettings settings;
   settings.sphereTree.depth = depth;
   settings.sphereTree.medialSamples = 2000;
@@ -44,6 +46,23 @@ inline CollisionBody makeTestBody(const TriangleMesh& mesh, std::uint32_t depth,
     body.setContactTree(buildContactTree(distance, ct));
   }
   return body;
+}
+
+/// buildTestBody, built once per process for each mesh and settings: many suites of a runner
+/// use the same cube, sphere or shared mesh, and a fixture is constructed for every test of its
+/// suite. Builds are deterministic, so a copy of the first build is the body a fresh build gives.
+inline CollisionBody makeTestBody(const TriangleMesh& mesh, std::uint32_t depth, bool withContactTree = true,
+                                  bool withClosestFeatureMap = true) {
+  std::string key(reinterpret_cast<const char*>(mesh.vertices.data()), mesh.vertices.size() * sizeof(Vec3));
+  key.append(reinterpret_cast<const char*>(mesh.triangles.data()), mesh.triangles.size() * sizeof(mesh.triangles[0]));
+  key += std::to_string(mesh.vertices.size()) + '/' + std::to_string(depth) + '/' + char('0' + withContactTree) +
+         char('0' + withClosestFeatureMap);
+  static std::mutex mutex;
+  static std::map<std::string, CollisionBody> built;
+  const std::lock_guard lock(mutex);
+  auto it = built.find(key);
+  if (it == built.end()) it = built.emplace(key, buildTestBody(mesh, depth, withContactTree, withClosestFeatureMap)).first;
+  return it->second;
 }
 
 /// A shared test mesh (../shared/data/meshes/NAME), centred and scaled to unit bounding-box

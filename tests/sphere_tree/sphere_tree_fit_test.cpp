@@ -144,8 +144,8 @@ TEST_P(ClosedMeshFit, MedialFitsTighterThanOctreeOnEveryLevelBelowTheRoot) {
   SphereTreeSettings settings;  // 8-ary, 4 levels below the root, as in the issue
   SphereFitSettings fitSettings;
   if (test::sanitizerRun()) {
-    settings.medialSamples = 5000;
-    fitSettings.samplesPerSphere = 40;
+    settings.medialSamples = 3000;
+    fitSettings.samplesPerSphere = 20;
   }
   settings.method = SphereTreeMethod::kOctree;
   const auto octree = measureSphereTreeFit(buildSphereTree(distance, settings), distance, fitSettings);
