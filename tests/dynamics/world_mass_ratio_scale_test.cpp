@@ -125,6 +125,48 @@ TEST(WorldMassRatio, HeavyOnLightAndLightOnHeavyStacksStandWithEveryModelAndBudg
         }
 }
 
+// The same stack dropped: the light box from 5 cm onto the ground, the 1,000 kg box from 10 cm
+// onto it. Both land flat and aligned, so by symmetry nothing pushes either sideways (oracle: the
+// start's x, y). The landing tilts the boxes by ~0.04 deg, and the heavy box's normal impulse,
+// 1,000 times the light box's weight, then has a tangential part the ground's static friction
+// cancels; integrating that friction by the trapezoid rule as if it were a smooth force moved
+// the light box 1 mm per step, 18 cm in 3 s (docs/dynamics.md, "Integration").
+TEST(WorldMassRatio, HeavyBoxDroppedOnALightOneStaysOnItWithEveryModel) {
+  for (ContactModel model : models())
+    for (std::uint64_t budget : budgets()) {
+      const std::string what = std::string(contactModelName(model)) + " budget " + std::to_string(budget);
+      World world = groundWorld(model, budget, 1.0);
+      const std::vector<BodyId> ids{world.addBody(cubeAt(1.0, 1.0, Vec3(0, 0, 0.55))),
+                                    world.addBody(cubeAt(1.0, 1000.0, Vec3(0, 0, 1.6)))};
+      double lowest = 0.0, farthest = 0.0, lastSecond = 0.0;
+      std::vector<Vec3> oneSecondAgo(ids.size());
+      for (int s = 0; s < 180; ++s) {  // 3 s
+        if (s == 120)
+          for (std::size_t i = 0; i < ids.size(); ++i) oneSecondAgo[i] = world.state(ids[i]).position;
+        world.step(1.0 / 60.0);
+        for (std::size_t i = 0; i < ids.size(); ++i) {
+          const Vec3 p = world.state(ids[i]).position;
+          lowest = std::max(lowest, (double(i) + 0.5) - p.z());
+          farthest = std::max(farthest, std::hypot(p.x(), p.y()));
+          if (s >= 120) lastSecond = std::max(lastSecond, (p - oneSecondAgo[i]).norm());
+        }
+      }
+      // The criteria of expectStackStands, except "at rest": at 1,000 : 1 the iterations leave
+      // the pinched pair a velocity residual of 1-2 cm/s that changes sign from step to step, a
+      // jitter of ~2.4 mm about a fixed pose (docs/dynamics.md, "Known limits"). So rest is the
+      // farthest either box got in the last second from where it was at its start: under 0.5 %
+      // of a side (the creep moved 6 cm in a second), and issue 17's resting-stack speed bound
+      // (5 cm/s) on the velocity.
+      EXPECT_LT(lowest, 0.02) << what << ": a box sank";
+      EXPECT_LT(farthest, 0.01) << what << ": a box moved sideways";
+      EXPECT_LT(lastSecond, 0.005) << what << ": moved in the last second";
+      for (BodyId id : ids) {
+        EXPECT_LT(world.state(id).velocity.norm(), 0.05) << what;
+        EXPECT_LT(tiltDegrees(world.state(id).orientation), 1.0) << what;
+      }
+    }
+}
+
 // The same box scenes from 1 mm to 100 m, each made from the unit shapes by World::addBody's
 // scale. Under a uniform scale by s with g fixed, motions keep their shape when time scales by
 // sqrt(s) (Froude similarity): speeds by sqrt(s), so a slide at 2 sqrt(s) m/s stops after
