@@ -94,6 +94,9 @@ struct Body {
   }
 };
 
+// The Coulomb coefficient of a contact between two bodies: the geometric mean of theirs.
+double pairFriction(const Body& a, const Body& b) { return std::sqrt(a.desc.friction * b.desc.friction); }
+
 // The inverse effective mass of a contact in its tangent plane, in the basis (t1, t2): the
 // tangential velocity change per unit tangential impulse, K = [k11 k12; k12 k22]. The two
 // tangents are coupled through the bodies' rotation (k12 != 0 off the principal axes).
@@ -1023,7 +1026,7 @@ void World::Impl::solve(double h) {
     const bool aLower = supportLayer[ids[0]] < supportLayer[ids[1]];
     Body& upper = aLower ? b : a;
     const double sign = aLower ? -1.0 : 1.0;  // impulses act on A along +, on B along -
-    const double mu = std::sqrt(a.desc.friction * b.desc.friction);
+    const double mu = pairFriction(a, b);
     for (SolverContact& cp : p->contacts) {
       const Vec3& r = aLower ? cp.rB : cp.rA;
       auto relative = [&]() -> Vec3 { return a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB); };
@@ -1067,7 +1070,7 @@ void World::Impl::solve(double h) {
     for (auto& [p, ids] : solveOrder) {
       Body& a = bodies[ids[0]];
       Body& b = bodies[ids[1]];
-      const double mu = std::sqrt(a.desc.friction * b.desc.friction);
+      const double mu = pairFriction(a, b);
       const double slipping = kSlipSpeedRel * std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal());
       for (SolverContact& cp : p->contacts) {
         const Vec3 vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
@@ -1120,7 +1123,7 @@ void World::Impl::solve(double h) {
       for (auto& [p, ids] : solveOrder) {
         Body& a = bodies[ids[0]];
         Body& b = bodies[ids[1]];
-        const double mu = std::sqrt(a.desc.friction * b.desc.friction);
+        const double mu = pairFriction(a, b);
         for (SolverContact& cp : p->contacts) {
           // Friction first, limited by the current normal impulse; then the normal, so that
           // non-penetration, the more important constraint, is solved last (Catto 2005).
@@ -1349,7 +1352,7 @@ void World::Impl::collectPressedNormals() {
   // friction impulse strictly inside the Coulomb cone (integrate says why it matters).
   sticking.assign(bodies.size(), 0);
   for (const auto& [p, ids] : solveOrder) {
-    const double mu = std::sqrt(bodies[ids[0]].desc.friction * bodies[ids[1]].desc.friction);
+    const double mu = pairFriction(bodies[ids[0]], bodies[ids[1]]);
     for (const SolverContact& cp : p->contacts) {
       if (!(cp.lambdaN > 0.0 || cp.lambdaP > 0.0 || cp.separation <= 0.0)) continue;
       add(ids[0], cp.c.normal);
