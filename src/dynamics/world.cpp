@@ -3,8 +3,6 @@
 #include "clod/world.h"
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -820,19 +818,22 @@ double World::Impl::reachSince(const Pose& bInAThen, const Body& a, const Body& 
 // contact of a freshly queried pair is matched one-to-one to the nearest unclaimed previous
 // contact of the pair within 5 % of the smaller diagonal whose normal is within ~18 degrees. A
 // match passes on its accumulated normal and friction impulses (warm starting) and -- if it came
-// from the same narrow-phase level and its two anchors have neither slid apart nor opened by more
-// than kAnchorDriftRel of the smaller diagonal -- its anchors too: the point stays where it was
-// first found on both bodies, so its separation is measured from the bodies' motion since then,
-// point by point. That is a per-point depth the exact model, whose contacts share one pair-wide
-// depth, cannot give: a box that tilts on another gets deeper anchors on one side and shallower
-// (or open, speculative) ones on the other, so the correction acts on the deeper side and the
-// velocity solve lets the open side come down. A new contact without a match is anchored at its
-// point, half its depth into each body. (A coarser or finer level re-anchors: its depth means
-// something else.)
+// from the same narrow-phase level, its two anchors have neither slid apart nor opened by more
+// than kAnchorDriftRel of the smaller diagonal, and they still stand for the new contact (their
+// midpoint within that drift of its point, their separation its depth within its error bound
+// plus the slop) -- its anchors too: the point stays where it was first found on both bodies,
+// so its separation is measured from the bodies' motion since then, point by point: a box that
+// tilts on another gets deeper anchors on one side and shallower (or open, speculative) ones on
+// the other, so the correction acts on the deeper side and the velocity solve lets the open side
+// come down. Anchors the new answer contradicts are dropped: the solver holds a matched pair
+// together, so a rolling bunny pivoted about its anchors while its fresh, 9 mm deep contacts were
+// held at 0. A new contact without kept anchors is anchored at its point, half its depth into
+// each body. (A coarser or finer level re-anchors: its depth means something else.)
 void World::Impl::persistContacts(PairState& p, const Body& a, const Body& b, double diag) {
   const double matchDistance = 0.05 * diag;
   const double drift = kAnchorDriftRel * diag;
-  if (keepFinerManifold(p, a, b, drift, settings.slopRel * diag)) return;
+  const double slop = settings.slopRel * diag;
+  if (keepFinerManifold(p, a, b, drift, slop)) return;
   for (auto& old : p.previous) old.matched = false;
   for (SolverContact& cp : p.contacts) {
     const Vec3& n = cp.c.normal;
@@ -855,7 +856,9 @@ void World::Impl::persistContacts(PairState& p, const Body& a, const Body& b, do
     cp.frictionImpulse = match->frictionImpulse;
     const Vec3 gap = a.x + a.q * match->anchorA - b.x - b.q * match->anchorB;
     const double open = gap.dot(n);
-    if (match->c.level == cp.c.level && open < drift && (gap - open * n).norm() < drift) {
+    const bool held = open < drift && (gap - open * n).norm() < drift;
+    const bool standsFor = best < drift && std::abs(-open - cp.c.depth) <= cp.c.errorBound + slop;
+    if (match->c.level == cp.c.level && held && standsFor) {
       cp.anchorA = match->anchorA;
       cp.anchorB = match->anchorB;
     }

@@ -149,6 +149,28 @@ TEST(MeshDropAtSixtyHertz, SpotStandsOnItsFourFeetWithTheContactTreeAtLowBudgets
   }
 }
 
+// The deepest any vertex of body 1 (the dropped mesh) goes below z = 0 (the ground's top face)
+// over `seconds` at `rateHz`, as a fraction of the mesh's diagonal.
+double deepestSinkOfDrop(const std::string& json, double rateHz, double seconds) {
+  SceneDescription scene = parseScene(json, CLOD_SHARED_MESH_DIR, "drop.json");
+  scene.dt = 1.0 / rateHz;
+  World world = buildWorld(scene, std::filesystem::path());
+  const BodyId mesh = 1;
+  const std::vector<Vec3>& vertices = world.desc(mesh).shape->mesh().vertices;
+  const double diagonal = world.desc(mesh).shape->diagonal();
+  double deepest = 0.0;
+  const int steps = static_cast<int>(seconds * rateHz);
+  for (int step = 0; step < steps; ++step) {
+    world.step(scene.dt);
+    const RigidBodyState st = world.state(mesh);
+    const Mat3 r = st.orientation.toRotationMatrix();
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const Vec3& v : vertices) lowest = std::min(lowest, r.row(2).dot(v));
+    deepest = std::max(deepest, -(lowest + st.position.z()) / diagonal);
+  }
+  return deepest;
+}
+
 // One of the random drops of scripts/probe-random-scenes.py (seed 24): a 0.76 m fandisk dropped
 // tumbling from 2.3 m lands on a corner. With the contact tree at 16 tests per frame it sank
 // 1.1-1.7 % of its diagonal while every sample's depth was corrected to S's surface, near its
@@ -162,25 +184,25 @@ TEST(RandomDrop, TumblingFandiskLandsOnACornerWithoutSinkingWithTheContactTree) 
        "orientation": [0.4794792653787865, -0.6993393515523344, -0.400521028034588, 0.3472852020232022],
        "friction": 0.7993715403649966}]})";
   const bool light = test::sanitizerRun();
-  for (double rate : light ? std::vector<double>{240.0} : std::vector<double>{60.0, 240.0}) {
-    SceneDescription scene = parseScene(json, CLOD_SHARED_MESH_DIR, "drop24.json");
-    scene.dt = 1.0 / rate;
-    World world = buildWorld(scene, std::filesystem::path());
-    const BodyId mesh = 1;
-    const std::vector<Vec3>& vertices = world.desc(mesh).shape->mesh().vertices;
-    const double diagonal = world.desc(mesh).shape->diagonal();
-    double deepest = 0.0;
-    const int steps = static_cast<int>((light ? 1.0 : 5.0) * rate);
-    for (int step = 0; step < steps; ++step) {
-      world.step(scene.dt);
-      const RigidBodyState st = world.state(mesh);
-      const Mat3 r = st.orientation.toRotationMatrix();
-      double lowest = std::numeric_limits<double>::infinity();
-      for (const Vec3& v : vertices) lowest = std::min(lowest, r.row(2).dot(v));
-      deepest = std::max(deepest, -(lowest + st.position.z()) / diagonal);
-    }
-    EXPECT_LE(deepest, 0.01) << "at " << rate << " Hz";
-  }
+  for (double rate : light ? std::vector<double>{240.0} : std::vector<double>{60.0, 240.0})
+    EXPECT_LE(deepestSinkOfDrop(json, rate, light ? 1.0 : 5.0), 0.01) << "at " << rate << " Hz";
+}
+
+// Another (seed 46): a 0.78 m bunny-1500 dropped from 1.5 m rocks on the box after it lands. With
+// the contact tree at 16 tests per frame and 60 Hz it sank 1.21 % of its diagonal over steps
+// 76-85 while every fresh answer said 4-9 mm deep (error bound 0.3 mm): each fresh contact was
+// matched to a previous one and kept that one's anchors, which the solver held together while the
+// bunny pivoted about them, so they said 0. A matched anchor pair that the fresh depth refutes is
+// now re-anchored (docs/dynamics.md, "Persistent, body-anchored contacts"); measured 0.66 %, at
+// the landing. Oracle: the ground's top face and the mesh's own vertices, the issue's 1 % limit.
+TEST(RandomDrop, RockingBunnyDoesNotSinkOnItsMatchedAnchorsWithTheContactTree) {
+  const std::string json = R"({"duration": 5.0, "contact_model": "contact-tree", "budget": 16, "bodies": [
+      {"name": "ground", "box": [2, 2, 0.25], "position": [0, 0, -0.25], "static": true, "friction": 0.6},
+      {"name": "mesh", "mesh": "bunny-1500.obj", "scale": 3.126312771910703,
+       "position": [-0.05776429421104168, 0.011349759198360506, 1.497946631227646],
+       "orientation": [0.6082663808441775, -0.6715967986901956, -0.41808530352643014, 0.06460982045339235],
+       "friction": 0.31609069492813385}]})";
+  EXPECT_LE(deepestSinkOfDrop(json, 60.0, 1.6), 0.01);
 }
 
 // One of the random drops of scripts/probe-random-scenes.py (seed 22): a 0.59 m bunny-1500 lands
@@ -189,8 +211,9 @@ TEST(RandomDrop, TumblingFandiskLandsOnACornerWithoutSinkingWithTheContactTree) 
 // unlimited budget too (0.07 m/s at 5 s). With rolling resistance (WorldSettings::
 // rollingResistanceRel, docs/dynamics.md) it comes to rest. Oracle: the issue's "come to rest",
 // the probe's 5 cm/s after 5 s (measured: 6e-12 m/s); control: without rolling resistance the
-// same run is still rocking at 5 s, above 1 cm/s (so the scene does rock; measured 4.2 cm/s, 7 cm/s
-// before the exact model's flat patches got their full depth, docs/narrow-phase.md).
+// same run is still rocking at 5 s, above 5 mm/s, a billion times the resisted run's speed (so the
+// scene does rock; measured 8.9 mm/s, since a fresh answer that contradicts a kept anchor's depth
+// re-anchors it; 4.2 cm/s before that, docs/dynamics.md).
 TEST(RandomDrop, BunnyLandedOnItsBackComesToRest) {
   const std::string json = R"({"duration": 5.0, "contact_model": "exact", "bodies": [
       {"name": "ground", "box": [2, 2, 0.25], "position": [0, 0, -0.25], "static": true, "friction": 0.6},
@@ -208,7 +231,7 @@ TEST(RandomDrop, BunnyLandedOnItsBackComesToRest) {
   };
   EXPECT_LT(finalSpeed(WorldSettings{}.rollingResistanceRel), 0.05);
   if (!test::sanitizerRun()) {
-    EXPECT_GT(finalSpeed(0.0), 0.01) << "the control: without rolling resistance it rocks";
+    EXPECT_GT(finalSpeed(0.0), 0.005) << "the control: without rolling resistance it rocks";
   }
 }
 
