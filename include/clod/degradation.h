@@ -93,12 +93,16 @@ struct ScenarioSettings {
   double seconds = 0.0;           ///< simulated time; 0 = defaultScenarioSeconds
   /// Folder of the shared meshes (bunny-1500.obj, spot.obj, fandisk.obj); drops only.
   std::filesystem::path meshDir;
+  /// Drops only: metres added to the drop height (finite), to measure how far a landing moves
+  /// when it starts a hair higher (the reference's own sensitivity, `clod experiment degradation`).
+  double dropHeightOffset = 0.0;
 };
 
 /// The scene of a scenario, with the settings applied (model, budgets, dt, steps; the stacks use
 /// WorldSettings::minSubsteps = 8 like scenes/stack_10.json). The tracked body is the last one.
 /// Drops read their mesh (to place it on the ground). Throws clod::Error(kInvalidArgument) for a
-/// non-positive or non-finite rate, negative seconds or a negative/non-finite budgetMicros, and
+/// non-positive or non-finite rate, negative seconds, a negative/non-finite budgetMicros or a
+/// non-finite dropHeightOffset, and
 /// the mesh loader's errors (mesh_io.h).
 SceneDescription makeScenario(ScenarioKind kind, const ScenarioSettings& settings);
 

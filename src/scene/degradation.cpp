@@ -182,6 +182,8 @@ SceneDescription makeScenario(ScenarioKind kind, const ScenarioSettings& setting
     throw Error(ErrorCode::kInvalidArgument, "scenario seconds must be finite and >= 0");
   if (!(settings.budgetMicros >= 0.0) || !std::isfinite(settings.budgetMicros))
     throw Error(ErrorCode::kInvalidArgument, "scenario budgetMicros must be finite and >= 0");
+  if (!std::isfinite(settings.dropHeightOffset))
+    throw Error(ErrorCode::kInvalidArgument, "scenario dropHeightOffset must be finite");
   SceneDescription scene;
   scene.world.model = settings.model;
   scene.world.budgetTests = settings.budgetTests;
@@ -244,6 +246,7 @@ SceneDescription makeScenario(ScenarioKind kind, const ScenarioSettings& setting
     case ScenarioKind::kDropFandisk: {
       scene.bodies.push_back(groundBox(Vec3(2.0, 2.0, kGroundHalfThickness), kDropFriction));
       scene.bodies.push_back(dropBody(kind, settings.meshDir));
+      scene.bodies.back().position.z() += settings.dropHeightOffset;
       break;
     }
   }

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <string>
 
 #include "clod/degradation.h"
@@ -141,6 +142,19 @@ TEST(DegradationScenarios, DroppedMeshesAreScaledToThreeQuarterMetreAndStartAbov
     EXPECT_NEAR((local.max - local.min).norm(), 0.75, 1e-9) << scenarioName(k);
     EXPECT_NEAR(world.min.z(), 0.25, 1e-9) << scenarioName(k);
   }
+}
+
+// The height offset (the experiment's perturbed references) moves the drop and nothing else.
+TEST(DegradationScenarios, DropHeightOffsetRaisesOnlyTheDroppedMesh) {
+  ScenarioSettings s = defaults();
+  const SceneDescription plain = makeScenario(ScenarioKind::kDropFandisk, s);
+  s.dropHeightOffset = 1e-5;
+  const SceneDescription raised = makeScenario(ScenarioKind::kDropFandisk, s);
+  // (1e-15: the rounding of adding 1e-5 to a height of ~0.3 m.)
+  EXPECT_LT((raised.bodies[1].position - plain.bodies[1].position - Vec3(0.0, 0.0, 1e-5)).norm(), 1e-15);
+  EXPECT_EQ(raised.bodies[0].position, plain.bodies[0].position);
+  s.dropHeightOffset = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(makeScenario(ScenarioKind::kDropFandisk, s), Error);
 }
 
 // scenes/<name>.json are the scenarios at their defaults (exact, unlimited, 60 Hz) for

@@ -18,6 +18,8 @@
 //           monotone_ok, wall_s_per_sim_s, cpu_s_per_sim_s, realtime, tests_spent,
 //           mean_budget_spent, max_budget_spent, pairs_skipped, pairs_interrupted, mean_narrow_us}
 //   summary[] {scenario, cells, plausible, monotone_checked, monotone, realtime, max_cpu_s_per_sim_s}
+//   reference_spread[] {scenario, rate_hz, height_offsets_m[], spread_m}: drops only; how far the
+//           exact reference's landing moves when it is dropped a few um higher or lower
 // degradation.csv has the rows' columns in the same order (failed: "; "-joined, quoted).
 #include <algorithm>
 #include <atomic>
@@ -164,6 +166,7 @@ ExperimentResult runDegradation(const ExperimentOptions& options) {
     ScenarioKind kind;
     double rateHz;
     ScenarioOutcome outcome;
+    double spread = 0.0;  // farthest landing of the perturbed runs from this one's
   };
   std::vector<Reference> references;
   for (ScenarioKind kind : kinds) {
@@ -174,7 +177,7 @@ ExperimentResult runDegradation(const ExperimentOptions& options) {
           for (std::size_t i = 0; i < references.size(); ++i)
             if (references[i].kind == kind && references[i].rateHz == rate) reference = static_cast<int>(i);
           if (reference < 0) {
-            references.push_back({kind, rate, {}});
+            references.push_back({kind, rate, {}, 0.0});
             reference = static_cast<int>(references.size() - 1);
           }
         }
@@ -203,9 +206,23 @@ ExperimentResult runDegradation(const ExperimentOptions& options) {
   };
   // Bake every shape once before the parallel runs, so they only read the cache.
   for (ScenarioKind kind : kinds) buildWorld(makeScenario(kind, settingsOf(kind, ContactModel::kCfm, false, 0, rates[0])), cacheDir);
-  tbb::parallel_for(std::size_t(0), references.size(), [&](std::size_t i) {
-    references[i].outcome = runScenario(references[i].kind, settingsOf(references[i].kind, ContactModel::kExact, false, 0, references[i].rateHz), cacheDir);
+  // Each reference is also run from a hair higher and lower: how far its own landing moves then
+  // is the floor under which a drop's budget-to-budget error differences say nothing.
+  const std::vector<double> offsets = {-1e-5, -1e-6, 1e-6, 1e-5};
+  std::vector<Vec3> perturbedFinal(references.size() * offsets.size());
+  tbb::parallel_for(std::size_t(0), references.size() * (1 + offsets.size()), [&](std::size_t j) {
+    const std::size_t i = j / (1 + offsets.size()), k = j % (1 + offsets.size());
+    ScenarioSettings s = settingsOf(references[i].kind, ContactModel::kExact, false, 0, references[i].rateHz);
+    if (k == 0) {
+      references[i].outcome = runScenario(references[i].kind, s, cacheDir);
+    } else {
+      s.dropHeightOffset = offsets[k - 1];
+      perturbedFinal[i * offsets.size() + k - 1] = runScenario(references[i].kind, s, cacheDir).finalCenter;
+    }
   });
+  for (std::size_t i = 0; i < references.size(); ++i)
+    for (std::size_t k = 0; k < offsets.size(); ++k)
+      references[i].spread = std::max(references[i].spread, (perturbedFinal[i * offsets.size() + k] - references[i].outcome.finalCenter).norm());
   std::atomic<std::size_t> done{0};
   tbb::parallel_for(std::size_t(0), cells.size(), [&](std::size_t i) {
     Cell& c = cells[i];
@@ -301,6 +318,16 @@ ExperimentResult runDegradation(const ExperimentOptions& options) {
                            formatNumber(maxCpu, 3)});
   }
 
+  doc["reference_spread"] = nlohmann::json::array();
+  if (!references.empty())
+    text << "Drops: the exact reference at an unlimited budget, dropped 1 and 10 um higher and lower, lands this far from itself\n";
+  for (const Reference& r : references) {
+    doc["reference_spread"].push_back({{"scenario", scenarioName(r.kind)}, {"rate_hz", r.rateHz}, {"height_offsets_m", offsets},
+                                       {"spread_m", r.spread}});
+    text << "  " << std::left << std::setw(15) << scenarioName(r.kind) << std::right << " " << std::setw(3) << formatNumber(r.rateHz, 0)
+         << " Hz  " << formatNumber(r.spread * 1e3, 2) << " mm\n";
+  }
+
   // Plots: error (mm) against the budget, one per scenario and budget kind, a curve per model and
   // rate. Unlimited is drawn at 4x the largest budget. Wide CSVs, one column per curve.
   for (ScenarioKind kind : kinds) {
@@ -364,6 +391,14 @@ ExperimentResult runDegradation(const ExperimentOptions& options) {
           "exact model's at an unlimited budget), in mm. ✗: implausible (degradation.csv says which criterion failed); "
           "↓: worse than the next smaller budget beyond the tolerance. Real time is judged on CPU time, as the machine "
           "is shared.</p>";
+  if (!references.empty()) {
+    std::vector<std::vector<std::string>> spreadRows;
+    for (const Reference& r : references)
+      spreadRows.push_back({std::string(scenarioName(r.kind)), formatNumber(r.rateHz, 0) + " Hz", formatNumber(r.spread * 1e3, 2)});
+    html << "<p>How far the exact reference's own landing moves when the mesh is dropped 1 or 10 &micro;m higher or lower "
+            "(mm): differences between budgets below this say nothing about the budget.</p>"
+         << htmlTable({"drop", "rate", "spread (mm)"}, spreadRows);
+  }
   for (ScenarioKind kind : kinds) {
     std::vector<std::string> header = {"model, rate"};
     for (double b : budgets) header.push_back(b == 0.0 ? "unlimited" : formatNumber(b, 0) + " tests");
