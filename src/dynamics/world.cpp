@@ -878,7 +878,12 @@ void World::Impl::persistContacts(PairState& p, const Body& a, const Body& b, do
 // the deepest contact's plane), so it never grows.
 void World::Impl::carryValidContacts(PairState& p, const Body& a, const Body& b, double matchDistance, double drift) {
   const std::size_t fresh = p.contacts.size();
-  if (fresh == 0) return;  // the query proved the bodies apart: nothing holds
+  // An empty answer ends the manifold when it is a finished one or proved the bodies apart. An
+  // interrupted one that found nothing proved nothing: the contact tree's roots' answer (two
+  // tests a substep) samples a few points, and a rolling bunny it had answered with one contact
+  // elsewhere fell freely for three frames through such answers while 6 mm of it was inside the
+  // floor; what still holds of the last manifold stays instead.
+  if (fresh == 0 && !(p.interrupted && !(p.apartBy > 0.0))) return;
   for (const SolverContact& old : p.previous) {
     if (old.matched) continue;
     const Vec3 pA = a.x + a.q * old.anchorA, pB = b.x + b.q * old.anchorB;
@@ -891,7 +896,7 @@ void World::Impl::carryValidContacts(PairState& p, const Body& a, const Body& b,
       near = near || (p.contacts[i].c.point - mid).norm() < matchDistance;
       agrees = agrees || p.contacts[i].c.normal.dot(old.c.normal) >= kWarmStartNormalCos;
     }
-    if (near || !agrees) continue;
+    if (fresh > 0 && (near || !agrees)) continue;
     p.contacts.push_back(old);
     p.contacts.back().c.point = mid;
     p.contacts.back().c.depth = -open;
@@ -929,8 +934,8 @@ void World::Impl::reduceCarried(std::vector<SolverContact>& contacts, std::size_
 // from their anchors, with their impulses -- and the new, coarser ones are dropped. So a pair
 // whose budget share shrank (more pairs in contact, a deadline) keeps the support its earlier,
 // finer queries found while the bodies have not moved enough to make it wrong, and more budget
-// can only make a pair's contacts finer, never replace them by coarser ones. An empty answer (the
-// query proved the bodies apart) always wins.
+// can only make a pair's contacts finer, never replace them by coarser ones. An empty answer is
+// left to carryValidContacts (it ends the manifold only if finished or proven apart).
 bool World::Impl::keepFinerManifold(PairState& p, const Body& a, const Body& b, double drift, double slop) {
   if (p.contacts.empty() || p.previous.empty()) return false;
   double newBound = std::numeric_limits<double>::infinity();
