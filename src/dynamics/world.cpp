@@ -882,7 +882,7 @@ void World::Impl::carryValidContacts(PairState& p, const Body& a, const Body& b,
   // interrupted one that found nothing proved nothing: the contact tree's roots' answer (two
   // tests a substep) samples a few points, and a rolling bunny it had answered with one contact
   // elsewhere fell freely for three frames through such answers while 6 mm of it was inside the
-  // floor; what still holds of the last manifold stays instead.
+  // floor. What is still pressed of the last manifold stays instead.
   if (fresh == 0 && !(p.interrupted && !(p.apartBy > 0.0))) return;
   for (const SolverContact& old : p.previous) {
     if (old.matched) continue;
@@ -896,7 +896,9 @@ void World::Impl::carryValidContacts(PairState& p, const Body& a, const Body& b,
       near = near || (p.contacts[i].c.point - mid).norm() < matchDistance;
       agrees = agrees || p.contacts[i].c.normal.dot(old.c.normal) >= kWarmStartNormalCos;
     }
-    if (fresh > 0 && (near || !agrees)) continue;
+    // With no fresh contact to agree with, only a still-pressed one is kept: one that has opened
+    // no longer supports anything, and its warm-started impulse kept a rocking bunny rocking.
+    if (fresh > 0 ? near || !agrees : open > 0.0) continue;
     p.contacts.push_back(old);
     p.contacts.back().c.point = mid;
     p.contacts.back().c.depth = -open;

@@ -219,9 +219,10 @@ TEST(RandomDrop, RockingBunnyDoesNotSinkOnItsMatchedAnchorsWithTheContactTree) {
 // at 16 tests per frame and 240 Hz, i.e. its roots' answer (two tests a substep). Some of those
 // answers found no contact -- interrupted, not a proof that the bodies are apart -- and the world
 // dropped the pair's manifold, so the bunny fell freely for three frames with 5.6 mm of it (0.95
-// % of its diagonal) inside the floor. An interrupted empty answer now keeps what still holds of
-// the manifold (docs/dynamics.md, "Graceful degradation"). Oracle: the ground's top face and the
-// mesh's vertices: a body deeper than the slop (0.2 % of its diagonal) in the floor has contacts.
+// % of its diagonal) inside the floor. An interrupted empty answer now keeps the manifold's
+// contacts that are still pressed (docs/dynamics.md, "Graceful degradation"). Oracle: the
+// ground's top face and the mesh's vertices: a body deeper than the slop (0.2 % of its diagonal)
+// in the floor has contacts.
 TEST(RandomDrop, RollingBunnyKeepsItsContactsThroughInterruptedEmptyAnswers) {
   const std::string json = R"({"duration": 5.0, "contact_model": "contact-tree", "budget": 16, "bodies": [
       {"name": "ground", "box": [2, 2, 0.25], "position": [0, 0, -0.25], "static": true, "friction": 0.6},
