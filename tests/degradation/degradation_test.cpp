@@ -212,6 +212,9 @@ TEST(RandomDrop, RockingBunnyDoesNotSinkOnItsMatchedAnchorsWithTheContactTree) {
        "position": [-0.05776429421104168, 0.011349759198360506, 1.497946631227646],
        "orientation": [0.6082663808441775, -0.6715967986901956, -0.41808530352643014, 0.06460982045339235],
        "friction": 0.31609069492813385}]})";
+  // (Release only: its code paths are the anchors' every substep, and its bake of the bunny's
+  // contact tree costs ~25 s under the sanitizers.)
+  if (test::sanitizerRun()) GTEST_SKIP() << "the sanitizer pass runs the interrupted-answer case below";
   EXPECT_LE(traceDrop(json, 60.0, 1.6).deepest, 0.01);
 }
 
