@@ -14,9 +14,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <filesystem>
+#include <iomanip>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -149,6 +152,33 @@ TEST(MeshDropAtSixtyHertz, SpotStandsOnItsFourFeetWithTheContactTreeAtLowBudgets
   }
 }
 
+// A drop drawn by scripts/probe-random-scenes.py: the mesh at its scale, position, orientation
+// (w, x, y, z) and friction over the probe's 4 x 4 x 0.5 m ground box, as the scene it wrote.
+struct ProbeDrop {
+  const char* mesh;
+  double scale;
+  std::array<double, 3> position;
+  std::array<double, 4> orientation;
+  double friction;
+};
+
+std::string probeDropScene(const ProbeDrop& d, const char* model, int budget) {
+  std::ostringstream json;
+  json << std::setprecision(17) << R"({"duration": 5.0, "contact_model": ")" << model << R"(", "budget": )" << budget
+       << R"(, "bodies": [{"name": "ground", "box": [2, 2, 0.25], "position": [0, 0, -0.25], "static": true, "friction": 0.6},)"
+       << R"({"name": "mesh", "mesh": ")" << d.mesh << R"(", "scale": )" << d.scale << R"(, "position": [)" << d.position[0]
+       << ", " << d.position[1] << ", " << d.position[2] << R"(], "orientation": [)" << d.orientation[0] << ", "
+       << d.orientation[1] << ", " << d.orientation[2] << ", " << d.orientation[3] << R"(], "friction": )" << d.friction
+       << "}]}";
+  return json.str();
+}
+
+// Seed 22's drop: a 0.59 m bunny-1500 that lands on its round back.
+constexpr ProbeDrop kSeed22Bunny = {"bunny-1500.obj", 2.3693665718084795,
+                                    {-0.20751049181587605, 0.08020049437480856, 0.971647600681705},
+                                    {0.18950184256577957, -0.6792264641085994, -0.5844594919280118, -0.40143189262184253},
+                                    0.33982872602247255};
+
 // How deep any vertex of body 1 (the dropped mesh) went below z = 0 (the ground's top face) over
 // `seconds` at `rateHz`, as fractions of the mesh's diagonal: at any step, and at steps after
 // which the solver had no contact between the ground and the mesh.
@@ -187,12 +217,11 @@ DropSink traceDrop(const std::string& json, double rateHz, double seconds) {
 // corners too (docs/contact-tree.md, "Depth at S's surface"). Oracle: the ground's top face and
 // the mesh's own vertices; the issue's limit is 1 % of the diagonal at any frame.
 TEST(RandomDrop, TumblingFandiskLandsOnACornerWithoutSinkingWithTheContactTree) {
-  const std::string json = R"({"duration": 5.0, "contact_model": "contact-tree", "budget": 16, "bodies": [
-      {"name": "ground", "box": [2, 2, 0.25], "position": [0, 0, -0.25], "static": true, "friction": 0.6},
-      {"name": "mesh", "mesh": "fandisk.obj", "scale": 0.0997208256665481,
-       "position": [-0.5323411219360095, 0.13384411551138947, 2.4584619492842554],
-       "orientation": [0.4794792653787865, -0.6993393515523344, -0.400521028034588, 0.3472852020232022],
-       "friction": 0.7993715403649966}]})";
+  const std::string json = probeDropScene({"fandisk.obj", 0.0997208256665481,
+                                           {-0.5323411219360095, 0.13384411551138947, 2.4584619492842554},
+                                           {0.4794792653787865, -0.6993393515523344, -0.400521028034588, 0.3472852020232022},
+                                           0.7993715403649966},
+                                          "contact-tree", 16);
   const bool light = test::sanitizerRun();
   for (double rate : light ? std::vector<double>{240.0} : std::vector<double>{60.0, 240.0})
     EXPECT_LE(traceDrop(json, rate, light ? 1.0 : 5.0).deepest, 0.01) << "at " << rate << " Hz";
@@ -206,12 +235,11 @@ TEST(RandomDrop, TumblingFandiskLandsOnACornerWithoutSinkingWithTheContactTree) 
 // now re-anchored (docs/dynamics.md, "Persistent, body-anchored contacts"); measured 0.66 %, at
 // the landing. Oracle: the ground's top face and the mesh's own vertices, the issue's 1 % limit.
 TEST(RandomDrop, RockingBunnyDoesNotSinkOnItsMatchedAnchorsWithTheContactTree) {
-  const std::string json = R"({"duration": 5.0, "contact_model": "contact-tree", "budget": 16, "bodies": [
-      {"name": "ground", "box": [2, 2, 0.25], "position": [0, 0, -0.25], "static": true, "friction": 0.6},
-      {"name": "mesh", "mesh": "bunny-1500.obj", "scale": 3.126312771910703,
-       "position": [-0.05776429421104168, 0.011349759198360506, 1.497946631227646],
-       "orientation": [0.6082663808441775, -0.6715967986901956, -0.41808530352643014, 0.06460982045339235],
-       "friction": 0.31609069492813385}]})";
+  const std::string json = probeDropScene({"bunny-1500.obj", 3.126312771910703,
+                                           {-0.05776429421104168, 0.011349759198360506, 1.497946631227646},
+                                           {0.6082663808441775, -0.6715967986901956, -0.41808530352643014, 0.06460982045339235},
+                                           0.31609069492813385},
+                                          "contact-tree", 16);
   // (Release only: its code paths are the anchors' every substep, and its bake of the bunny's
   // contact tree costs ~25 s under the sanitizers.)
   if (test::sanitizerRun()) GTEST_SKIP() << "the sanitizer pass runs the interrupted-answer case below";
@@ -227,12 +255,7 @@ TEST(RandomDrop, RockingBunnyDoesNotSinkOnItsMatchedAnchorsWithTheContactTree) {
 // ground's top face and the mesh's vertices: a body deeper than the slop (0.2 % of its diagonal)
 // in the floor has contacts.
 TEST(RandomDrop, RollingBunnyKeepsItsContactsThroughInterruptedEmptyAnswers) {
-  const std::string json = R"({"duration": 5.0, "contact_model": "contact-tree", "budget": 16, "bodies": [
-      {"name": "ground", "box": [2, 2, 0.25], "position": [0, 0, -0.25], "static": true, "friction": 0.6},
-      {"name": "mesh", "mesh": "bunny-1500.obj", "scale": 2.3693665718084795,
-       "position": [-0.20751049181587605, 0.08020049437480856, 0.971647600681705],
-       "orientation": [0.18950184256577957, -0.6792264641085994, -0.5844594919280118, -0.40143189262184253],
-       "friction": 0.33982872602247255}]})";
+  const std::string json = probeDropScene(kSeed22Bunny, "contact-tree", 16);
   const DropSink sink = traceDrop(json, 240.0, 1.6);
   EXPECT_LE(sink.deepestWithoutContacts, 0.002);
   EXPECT_LE(sink.deepest, 0.01);
@@ -248,12 +271,7 @@ TEST(RandomDrop, RollingBunnyKeepsItsContactsThroughInterruptedEmptyAnswers) {
 // scene does rock; measured 8.9 mm/s, since a fresh answer that contradicts a kept anchor's depth
 // re-anchors it; 4.2 cm/s before that, docs/dynamics.md).
 TEST(RandomDrop, BunnyLandedOnItsBackComesToRest) {
-  const std::string json = R"({"duration": 5.0, "contact_model": "exact", "bodies": [
-      {"name": "ground", "box": [2, 2, 0.25], "position": [0, 0, -0.25], "static": true, "friction": 0.6},
-      {"name": "mesh", "mesh": "bunny-1500.obj", "scale": 2.3693665718084795,
-       "position": [-0.20751049181587605, 0.08020049437480856, 0.971647600681705],
-       "orientation": [0.18950184256577957, -0.6792264641085994, -0.5844594919280118, -0.40143189262184253],
-       "friction": 0.33982872602247255}]})";
+  const std::string json = probeDropScene(kSeed22Bunny, "exact", 0);
   auto finalSpeed = [&](double rolling) {
     SceneDescription scene = parseScene(json, CLOD_SHARED_MESH_DIR, "drop22.json");
     scene.dt = 1.0 / 240.0;
