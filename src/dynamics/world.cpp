@@ -883,7 +883,8 @@ void World::Impl::carryValidContacts(PairState& p, const Body& a, const Body& b,
   // tests a substep) samples a few points, and a rolling bunny it had answered with one contact
   // elsewhere fell freely for three frames through such answers while 6 mm of it was inside the
   // floor. What is still pressed of the last manifold stays instead.
-  if (fresh == 0 && !(p.interrupted && !(p.apartBy > 0.0))) return;
+  const bool provedNothing = p.interrupted && !(p.apartBy > 0.0);
+  if (fresh == 0 && !provedNothing) return;
   for (const SolverContact& old : p.previous) {
     if (old.matched) continue;
     const Vec3 pA = a.x + a.q * old.anchorA, pB = b.x + b.q * old.anchorB;

@@ -177,7 +177,7 @@ ExperimentResult runDegradation(const ExperimentOptions& options) {
           for (std::size_t i = 0; i < references.size(); ++i)
             if (references[i].kind == kind && references[i].rateHz == rate) reference = static_cast<int>(i);
           if (reference < 0) {
-            references.push_back({kind, rate, {}, 0.0});
+            references.push_back({kind, rate, {}});
             reference = static_cast<int>(references.size() - 1);
           }
         }
