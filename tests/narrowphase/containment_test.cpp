@@ -215,8 +215,7 @@ TEST(Containment, SmallSpotInsideSpotIsPushedTowardTheNearestSurface) {
   ASSERT_TRUE(MeshTopology(spot).closed());
   TriangleMesh small = spot;
   for (Vec3& v : small.vertices) v *= 0.04;
-  // Depth 2 under the sanitizers, as the error-bound suite's spot there (one build for both).
-  const CollisionBody outer = test::makeTestBody(spot, test::sanitizerRun() ? 2 : 3);
+  const CollisionBody outer = test::makeTestBody(spot, test::curvedMeshTestDepth());
   const CollisionBody inner = test::makeTestBody(small, 1);
   const MeshDistance oracle(spot);
   // A point 0.05 behind a triangle's centroid whose closest surface point is that centroid, and

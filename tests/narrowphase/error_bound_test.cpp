@@ -44,10 +44,7 @@ struct Shape {
 Shape makeShape(const std::string& name, const TriangleMesh& mesh) {
   Shape s;
   s.name = name;
-  // Under the sanitizers sphere-trees of depth 2, which other suites of this runner build too
-  // (makeTestBody shares them): the rates are asserted in Release only, and depth 3 adds
-  // levels, not code paths.
-  s.body = std::make_unique<CollisionBody>(test::makeTestBody(mesh, test::sanitizerRun() ? 2 : 3));
+  s.body = std::make_unique<CollisionBody>(test::makeTestBody(mesh, test::curvedMeshTestDepth()));
   s.distance = std::make_unique<MeshDistance>(mesh);
   return s;
 }

@@ -65,6 +65,12 @@ inline CollisionBody makeTestBody(const TriangleMesh& mesh, std::uint32_t depth,
   return it->second;
 }
 
+/// The sphere-tree depth of the suites that check curved shared meshes at many poses (error
+/// bounds, containment): 3, and under the sanitizers 2, the depth other suites of the runner
+/// build those meshes at, so makeTestBody builds each once per process. Depth 3 adds levels,
+/// not code paths; the rates that need it are asserted in Release only.
+inline std::uint32_t curvedMeshTestDepth() { return sanitizerRun() ? 2 : 3; }
+
 /// A shared test mesh (../shared/data/meshes/NAME), centred and scaled to unit bounding-box
 /// diagonal, so tolerances in units of the diagonal read as plain numbers.
 inline TriangleMesh loadUnitMesh(const std::string& name) {
