@@ -45,9 +45,10 @@
 // keep its frontier -- at most max(cached front, tests) pairs -- within what it may spend: a pair
 // whose cached front costs more than the substep has left waits for the next substep (it is then
 // ranked first), and one whose front costs more than a substep's even share restarts from the
-// roots. A dos pair with an immovable body whose query the budget interrupted answers along the
-// immovable body's box-outward direction instead of the D&O centre line (docs/dynamics.md, "dos
-// against immovable bodies"); finished dos queries keep their D&O normals.
+// roots. A sphere-model pair (dos, average) whose query the budget interrupted answers along the
+// supporting body's box-outward direction (the immovable or the heavier body) instead of the
+// spheres' normals (docs/dynamics.md, "Sphere models' interrupted contacts"); finished queries
+// keep their model's normals.
 //
 // Energy: the velocity solve is checked -- if the warm-started solve ends with more kinetic energy
 // than it started with, it is redone from zero impulses -- and the restitution impulses are scaled

@@ -676,24 +676,33 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     const double restitution = std::max(a.desc.restitution, b.desc.restitution);
     const double diag = std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal());
     const bool aFixed = a.invMass == 0.0, bFixed = b.invMass == 0.0;
-    if (s.model == ContactModel::kDos && aFixed != bFixed && p->interrupted) {
-      // A D&O contact's normal is the centre line of two bounding spheres: it carries no surface.
-      // Against an immovable body it is the moving body's whole support, and from the big spheres
-      // a query stopped by the budget leaves it at -- a floor slab's root or first levels -- it
-      // leans toward the horizontal, the more the deeper the body sinks: in the 200-body bin bodies
-      // slid down through the floor and fell until they left the bounds (the "energy gain" of
-      // the dos rows was their free fall: docs/dynamics.md, "dos against immovable bodies"). So
-      // an interrupted pair's D&O contacts against an immovable body fall back to that body's
-      // own surface direction: the outward direction of its oriented bounding box from the point
-      // nearest the moving body's centre of mass. A centre inside the box (a sunken body, or one
-      // inside a concave static mesh's box) keeps the D&O normal: the box says nothing there. A
-      // finished query (unlimited budget, or a level cap: the experiments that compare normals,
-      // e.g. `clod experiment landing`) keeps pure D&O normals. Done before persistContacts, so
-      // the anchors and the warm-start matching see the normal the solver uses.
-      const Vec3 n = outwardFromBox(aFixed ? a : b, (aFixed ? b : a).x);
-      if (n.squaredNorm() > 0.0)
+    const bool sphereModel = s.model == ContactModel::kDos || s.model == ContactModel::kAverage;
+    if (sphereModel && !(aFixed && bFixed) && p->interrupted) {
+      // A D&O contact's normal is the centre line of two bounding spheres, an average-model one
+      // the mean normal of a sphere's triangles: from the big spheres a query stopped by the budget
+      // leaves them at, neither carries a surface. Against an immovable body such a contact is the
+      // moving body's whole support, and it leans toward the horizontal, the more the deeper the
+      // body sinks: in the 200-body bin bodies slid down through the floor and fell until they left
+      // the bounds (docs/dynamics.md, "Sphere models' interrupted contacts"). Between two moving
+      // bodies the same lean under a heavy body squeezed the light one out or tipped the pair:
+      // a 100 kg box dropped on a 1 kg box at 16 tests per frame slid off (dos, 0.77 m) or fell
+      // through it and the ground (average). So an interrupted pair's sphere-model contacts take
+      // the supporting body's own surface direction: the outward direction of its oriented
+      // bounding box from the point nearest the other body's centre of mass. The supporting body
+      // is the immovable one, else the heavier (what rests on it, or what it holds up); where the
+      // other centre lies inside its box (a sunken body, a body inside a concave mesh's box) the
+      // other body's box is asked, and where both say nothing the sphere normal stays. A finished
+      // query (unlimited budget, or a level cap: the experiments that compare normals, e.g.
+      // `clod experiment landing`) keeps its model's normals. Done before persistContacts, so the
+      // anchors and the warm-start matching see the normal the solver uses.
+      const bool aSupports = aFixed || (!bFixed && a.desc.mass >= b.desc.mass);
+      Vec3 outOfA = aSupports ? outwardFromBox(a, b.x) : Vec3(-outwardFromBox(b, a.x));
+      if (outOfA.squaredNorm() == 0.0 && !aFixed && !bFixed)
+        outOfA = aSupports ? Vec3(-outwardFromBox(b, a.x)) : outwardFromBox(a, b.x);
+      // The contact normal points out of B toward A.
+      if (outOfA.squaredNorm() > 0.0)
         for (SolverContact& cp : p->contacts)
-          if (cp.c.errorBound > 0.0) cp.c.normal = aFixed ? Vec3(-n) : n;
+          if (cp.c.errorBound > 0.0) cp.c.normal = -outOfA;
     }
     if (p->fresh) persistContacts(*p, a, b, diag);
     double maxDepth = 0.0;
