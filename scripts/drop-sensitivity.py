@@ -12,17 +12,11 @@ step whose outcome differs by less than this is a different landing, not a worse
 """
 import csv, json, math, os, subprocess, sys, tempfile
 
+from clod_rotation import rotate
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CLOD = os.environ.get('CLOD', os.path.join(ROOT, 'build', 'bin', 'clod'))
 OFFSETS = [0.0, 1e-6, -1e-6, 1e-5, -1e-5]
-
-
-def rotate(q, v):
-    w, x, y, z = q
-    m = [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-         [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-         [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
-    return [sum(m[i][j] * v[j] for j in range(3)) for i in range(3)]
 
 
 def final_centroid(scene, mesh_body, centroid, workdir, offset):

@@ -14,6 +14,9 @@ and a count. Each run's scene,
 trajectory and summary stay in OUTDIR.
 """
 import json, math, os, random, subprocess, sys, csv, concurrent.futures as cf
+
+from clod_rotation import rotate as rot
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CLOD = os.environ.get('CLOD', os.path.join(ROOT, 'build', 'bin', 'clod'))
 MESHES = os.environ.get('CLOD_MESH_DIR', os.path.join(ROOT, '..', 'shared', 'data', 'meshes'))
@@ -25,10 +28,6 @@ def qy(deg):
 def qmul(a, b):
     w1,x1,y1,z1=a; w2,x2,y2,z2=b
     return [w1*w2-x1*x2-y1*y2-z1*z2, w1*x2+x1*w2+y1*z2-z1*y2, w1*y2-x1*z2+y1*w2+z1*x2, w1*z2+x1*y2-y1*x2+z1*w2]
-def rot(q, v):
-    w,x,y,z=q
-    m=[[1-2*(y*y+z*z),2*(x*y-w*z),2*(x*z+w*y)],[2*(x*y+w*z),1-2*(x*x+z*z),2*(y*z-w*x)],[2*(x*z-w*y),2*(y*z+w*x),1-2*(x*x+y*y)]]
-    return [sum(m[i][j]*v[j] for j in range(3)) for i in range(3)]
 def tilt(q0, q):
     # angle between body z axes
     a = rot(q0, [0,0,1]); b = rot(q, [0,0,1])

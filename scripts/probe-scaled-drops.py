@@ -15,18 +15,12 @@ more than 1 % or still moves faster than 1 % of its diagonal per second at the e
 """
 import concurrent.futures as cf, csv, json, math, os, subprocess, sys
 
+from clod_rotation import rotate
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CLOD = os.environ.get('CLOD', os.path.join(ROOT, 'build', 'bin', 'clod'))
 MESHES = os.environ.get('CLOD_MESH_DIR', os.path.join(ROOT, '..', 'shared', 'data', 'meshes'))
 TURN = [math.cos(math.pi / 8), math.sin(math.pi / 8), 0.0, 0.0]  # 45 deg about x
-
-
-def rotate(q, v):
-    w, x, y, z = q
-    m = [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-         [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-         [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
-    return [sum(m[i][j] * v[j] for j in range(3)) for i in range(3)]
 
 
 def vertices(mesh):

@@ -696,13 +696,14 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       // `clod experiment landing`) keeps its model's normals. Done before persistContacts, so the
       // anchors and the warm-start matching see the normal the solver uses.
       const bool aSupports = aFixed || (!bFixed && a.desc.mass >= b.desc.mass);
-      Vec3 outOfA = aSupports ? outwardFromBox(a, b.x) : Vec3(-outwardFromBox(b, a.x));
-      if (outOfA.squaredNorm() == 0.0 && !aFixed && !bFixed)
-        outOfA = aSupports ? Vec3(-outwardFromBox(b, a.x)) : outwardFromBox(a, b.x);
+      const Body& support = aSupports ? a : b;
+      const Body& other = aSupports ? b : a;
+      Vec3 outOfSupport = outwardFromBox(support, other.x);
+      if (outOfSupport.squaredNorm() == 0.0 && support.invMass > 0.0) outOfSupport = -outwardFromBox(other, support.x);
       // The contact normal points out of B toward A.
-      if (outOfA.squaredNorm() > 0.0)
+      if (outOfSupport.squaredNorm() > 0.0)
         for (SolverContact& cp : p->contacts)
-          if (cp.c.errorBound > 0.0) cp.c.normal = -outOfA;
+          if (cp.c.errorBound > 0.0) cp.c.normal = aSupports ? Vec3(-outOfSupport) : outOfSupport;
     }
     if (p->fresh) persistContacts(*p, a, b, diag);
     double maxDepth = 0.0;
