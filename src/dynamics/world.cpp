@@ -51,6 +51,24 @@ constexpr std::uint32_t kShockPasses = 2;
 
 bool finite(const Vec3& v) { return v.allFinite(); }
 
+// What substep i of n may spend of a step's `budget` units, `spent` of them already gone: an
+// equal share of what the step has left, rounded up (what a substep does not spend rolls over to
+// the ones after it), but never ahead of the even schedule -- by its end substep i may have spent
+// ceil(budget (i + 1) / n). The schedule matters where the substeps outnumber the units: the
+// queries are then spaced every n / budget substeps from the first. Rounding each share up gave
+// each of the first substeps a unit and left the rest of the step without queries -- a 1 mm
+// bunny at 60 Hz and 16 tests per frame, spinning at ~100 rad/s in 128 substeps, kept 112
+// substeps' stale contacts and sank 11 % of its diagonal.
+std::uint64_t substepAllowance(std::uint64_t budget, std::uint64_t spent, std::uint32_t i, std::uint32_t n) {
+  const std::uint64_t left = budget - std::min(budget, spent);
+  const std::uint64_t share = (left + (n - i) - 1) / (n - i);
+  // ceil(budget (i + 1) / n) without overflow (a budget may be up to 2^64 - 1 units):
+  // budget = q n + r with r < n, and r (i + 1) < n^2 fits.
+  const std::uint64_t q = budget / n, r = budget % n;
+  const std::uint64_t target = q * (i + 1) + (r * (i + 1) + n - 1) / n;
+  return std::min(share, target > spent ? target - spent : 0);
+}
+
 Mat3 worldInverseInertia(const Mat3& invInertiaLocal, const Quat& q) {
   const Mat3 r = q.toRotationMatrix();
   return r * invInertiaLocal * r.transpose();
@@ -1516,12 +1534,12 @@ const StepReport& World::step(double dt) {
   const bool limited = budget != 0;
   m.report.timeBudgetMicros = m.settings.budgetMicros;
   for (std::uint32_t i = 0; i < n; ++i) {
-    const std::uint64_t left = limited ? budget - std::min(budget, m.report.budgetSpent) : 0;
     const std::uint64_t substepsLeft = n - i;
+    const std::uint64_t allowance = limited ? substepAllowance(budget, m.report.budgetSpent, i, n) : 0;
     // The time budget's backstop likewise: an equal share of what the step has left.
     const double timeLeft = std::max(0.0, m.settings.budgetMicros - m.report.timeSpentMicros) * 1e-6;
     const double timeAllowance = timedStep ? timeLeft / static_cast<double>(substepsLeft) : -1.0;
-    m.substep(h, limited, (left + substepsLeft - 1) / substepsLeft, (budget + n - 1) / n, timeAllowance);
+    m.substep(h, limited, allowance, (budget + n - 1) / n, timeAllowance);
     m.checkFinite();
   }
   if (timedStep && m.report.unitsWorked > 0) {
