@@ -229,8 +229,9 @@ struct PairReport {
   /// without triangle tests (QueryResult::fallbackPairs), and the contact tree's pairs answered
   /// past a time budget's substep time (docs/dynamics.md); 0 at an unlimited budget.
   std::uint64_t fallbackPairs = 0;
-  /// The last query's answer was coarser than the pair's manifold, which still held, so the
-  /// finer manifold was kept (docs/dynamics.md, "Persistent manifold").
+  /// The last query was interrupted and its answer coarser than the pair's manifold, which still
+  /// held, so the finer manifold was kept (a finished answer always replaces it;
+  /// docs/dynamics.md, "Graceful degradation").
   bool keptFiner = false;
   std::uint32_t contacts = 0;  ///< contacts the solver used in the last substep
 };
