@@ -31,7 +31,9 @@
 //      see docs/dynamics.md).
 //
 // Budget division (the time-critical part): WorldSettings::budgetTests is per step (frame). A
-// substep may spend ceil(tests the step has left / substeps left). Within a substep the
+// substep may spend ceil(tests the step has left / substeps left), but never run ahead of the
+// even schedule ceil(budgetTests (i + 1) / n) by the end of substep i of n, so substeps that
+// outnumber the tests get evenly spaced queries. Within a substep the
 // candidate pairs are ranked first by how many substeps they have gone without a query (round
 // robin: a starved pair moves to the front), then by priority = approach speed along last contact
 // normal + last deepest depth / dt. Walking down the list, each pair gets share = remaining /
@@ -120,7 +122,8 @@ struct WorldSettings {
   ContactModel model = ContactModel::kCfm;
   /// Sphere/triangle tests per step (per World::step, i.e. per frame) for all pairs and all
   /// substeps together; 0 = unlimited. A step never spends more. Each substep gets an equal
-  /// share of what the step has left (rounded up); what it does not spend rolls over.
+  /// share of what the step has left (rounded up), never ahead of an even spread over the
+  /// step's substeps; what it does not spend rolls over.
   std::uint64_t budgetTests = 0;
   /// Narrow-phase wall-clock time per step in microseconds, for all pairs and substeps together;
   /// 0 = no time limit (finite, >= 0). Each step converts it to budget units at the narrow
