@@ -832,8 +832,8 @@ void bindDynamics(py::module_& mod) {
           "pairs", [](const StepReport& r) {
             const py::ssize_t n = static_cast<py::ssize_t>(r.pairs.size());
             py::array_t<std::uint32_t> bodies({n, py::ssize_t(2)}), level(n), contacts(n);
-            py::array_t<std::uint64_t> tests(n);
-            py::array_t<bool> finished(n), skipped(n);
+            py::array_t<std::uint64_t> tests(n), fallbackPairs(n);
+            py::array_t<bool> finished(n), skipped(n), reused(n), provenApart(n), keptFiner(n);
             for (py::ssize_t i = 0; i < n; ++i) {
               const PairReport& p = r.pairs[static_cast<std::size_t>(i)];
               bodies.mutable_data()[2 * i] = p.a;
@@ -841,8 +841,12 @@ void bindDynamics(py::module_& mod) {
               level.mutable_data()[i] = p.level;
               contacts.mutable_data()[i] = p.contacts;
               tests.mutable_data()[i] = p.tests;
+              fallbackPairs.mutable_data()[i] = p.fallbackPairs;
               finished.mutable_data()[i] = p.finished;
               skipped.mutable_data()[i] = p.skipped;
+              reused.mutable_data()[i] = p.reused;
+              provenApart.mutable_data()[i] = p.provenApart;
+              keptFiner.mutable_data()[i] = p.keptFiner;
             }
             py::dict out;
             out["bodies"] = bodies;
@@ -850,10 +854,16 @@ void bindDynamics(py::module_& mod) {
             out["level"] = level;
             out["finished"] = finished;
             out["skipped"] = skipped;
+            out["reused"] = reused;
+            out["proven_apart"] = provenApart;
+            out["kept_finer"] = keptFiner;
+            out["fallback_pairs"] = fallbackPairs;
             out["contacts"] = contacts;
             return out;
           },
-          "per-pair report as a dict of arrays: bodies (n, 2), tests, level, finished, skipped, contacts")
+          "per-pair report as a dict of arrays (include/clod/world.h, PairReport): bodies (n, 2), tests, level,\n"
+          "finished, skipped, reused (manifold reuse), proven_apart, kept_finer (an interrupted answer held back by\n"
+          "a finer manifold), fallback_pairs, contacts")
       .def("__repr__", [](const StepReport& r) {
         return "<clod.StepReport " + std::to_string(r.substeps) + " substeps, " + std::to_string(r.testsSpent) + " tests, " +
                std::to_string(r.contacts.size()) + " contacts>";

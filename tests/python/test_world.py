@@ -63,6 +63,21 @@ def test_dropped_box_comes_to_rest_on_the_ground(ground_and_box):
     assert report.pairs["bodies"].tolist() == [[0, 1]]
 
 
+def test_pair_report_says_when_a_resting_manifold_is_reused(ground_and_box):
+    # A box resting on the ground at an unlimited budget: each finished answer is reused while the
+    # bodies have not moved against each other by 0.1 % of the smaller diagonal (docs/dynamics.md,
+    # "Manifold reuse"), so once it rests the pair is not queried (no tests) yet keeps contacts.
+    world = make_world(*ground_and_box, height=0.5, model="cfm", budget=0)
+    reports = [world.step() for _ in range(60)]
+    last = reports[-1].pairs
+    assert last["bodies"].tolist() == [[0, 1]]
+    assert last["reused"].tolist() == [True] and last["tests"].tolist() == [0] and last["contacts"][0] >= 4
+    assert last["proven_apart"].tolist() == [False] and last["kept_finer"].tolist() == [False]
+    assert last["fallback_pairs"].tolist() == [0] and last["skipped"].tolist() == [False]
+    # The first step queried it (nothing to reuse yet).
+    assert reports[0].pairs["reused"].tolist() == [False] and reports[0].pairs["tests"][0] > 0
+
+
 def test_scene_worlds_are_deterministic_and_overridable(source_dir):
     scene = str(source_dir / "scenes" / "stack_5.json")
     a = clod.World.from_scene(scene, model="cfm", budget=64)
