@@ -177,6 +177,7 @@ TEST(MeshDropAtSixtyHertz, SpotStandsOnItsFourFeetWithTheContactTreeAtLowBudgets
 
 // A drop drawn by scripts/probe-random-scenes.py: the mesh at its scale, position, orientation
 // (w, x, y, z) and friction over the probe's 4 x 4 x 0.5 m ground box, as the scene it wrote.
+// `groundScale` scales that box (scripts/probe-scaled-drops.py: 4 x 4 x 0.5 of the mesh's diagonal).
 struct ProbeDrop {
   const char* mesh;
   double scale;
@@ -185,10 +186,12 @@ struct ProbeDrop {
   double friction;
 };
 
-std::string probeDropScene(const ProbeDrop& d, const char* model, int budget) {
+std::string probeDropScene(const ProbeDrop& d, const char* model, int budget, double groundScale = 1.0) {
+  const double g = groundScale;
   std::ostringstream json;
   json << std::setprecision(17) << R"({"duration": 5.0, "contact_model": ")" << model << R"(", "budget": )" << budget
-       << R"(, "bodies": [{"name": "ground", "box": [2, 2, 0.25], "position": [0, 0, -0.25], "static": true, "friction": 0.6},)"
+       << R"(, "bodies": [{"name": "ground", "box": [)" << 2 * g << ", " << 2 * g << ", " << 0.25 * g
+       << R"(], "position": [0, 0, )" << -0.25 * g << R"(], "static": true, "friction": 0.6},)"
        << R"({"name": "mesh", "mesh": ")" << d.mesh << R"(", "scale": )" << d.scale << R"(, "position": [)" << d.position[0]
        << ", " << d.position[1] << ", " << d.position[2] << R"(], "orientation": [)" << d.orientation[0] << ", "
        << d.orientation[1] << ", " << d.orientation[2] << ", " << d.orientation[3] << R"(], "friction": )" << d.friction
@@ -339,13 +342,11 @@ TEST(RandomDrop, PivotingBunnySinksNoDeeperAtAnUnlimitedBudgetWithTheContactTree
 // 45 deg about x, its lowest point 0.3 mm above a 4 x 4 x 0.5 mm box. Oracle: the box's top face
 // and the mesh's own vertices; the issue's limit, 1 % of the diagonal at any frame.
 TEST(MillimetreDrop, FandiskAtSixtyHertzAndSixteenTestsPerFrameDoesNotSink) {
-  const std::string json = R"({"duration": 4.0, "contact_model": "cfm", "budget": 16, "bodies": [)"
-                           R"({"name": "ground", "box": [0.002, 0.002, 0.00025], "position": [0, 0, -0.00025],)"
-                           R"( "static": true, "friction": 0.6},)"
-                           R"({"name": "mesh", "mesh": "fandisk.obj", "scale": 0.0001313096111255228,)"
-                           R"( "position": [-0.0003169748357764557, -0.0014448763613275507, -0.000664042112639844],)"
-                           R"( "orientation": [0.9238795325112867, 0.3826834323650898, 0.0, 0.0],)"
-                           R"( "friction": 0.6, "density": 1000}]})";
+  const std::string json = probeDropScene({"fandisk.obj", 0.0001313096111255228,
+                                           {-0.0003169748357764557, -0.0014448763613275507, -0.000664042112639844},
+                                           {0.9238795325112867, 0.3826834323650898, 0.0, 0.0},
+                                           0.6},
+                                          "cfm", 16, 0.001);
   EXPECT_LE(traceDrop(json, 60.0, test::sanitizerRun() ? 0.5 : 2.0).deepest, 0.01);
 }
 
