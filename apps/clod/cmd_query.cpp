@@ -20,6 +20,7 @@
 #include "clod/bake.h"
 #include "clod/collision_body.h"
 #include "clod/error.h"
+#include "clod/quaternion.h"
 #include "clod/query.h"
 #include "command.h"
 
@@ -49,22 +50,12 @@ Pose parsePose(const std::string& text, const char* option) {
   }
   std::string rest;
   if (in >> rest) throw Error(ErrorCode::kInvalidArgument, std::string(option) + " '" + text + "': more than 7 numbers");
-  Quat q(v[3], v[4], v[5], v[6]);
-  const double norm = q.norm();
-  if (!(norm > 1e-12)) throw Error(ErrorCode::kInvalidArgument, std::string(option) + " '" + text + "': zero quaternion");
+  const std::optional<Quat> q = unitQuaternion(v[3], v[4], v[5], v[6]);
+  if (!q) throw Error(ErrorCode::kInvalidArgument, std::string(option) + " '" + text + "': zero quaternion");
   Pose pose;
-  pose.rotation = Quat(q.coeffs() / norm);
+  pose.rotation = *q;
   pose.translation = Vec3(v[0], v[1], v[2]);
   return pose;
-}
-
-const char* stopName(QueryStop stop) {
-  switch (stop) {
-    case QueryStop::kFinished: return "finished";
-    case QueryStop::kTestBudget: return "test_budget";
-    case QueryStop::kDeadline: return "deadline";
-  }
-  return "unknown";
 }
 
 int runQuery(const QueryOptions& options) {
@@ -112,7 +103,7 @@ int runQuery(const QueryOptions& options) {
                {"finished", result.finished},
                {"seconds", result.seconds},
                {"model", std::string(contactModelName(settings.model))},
-               {"stop", stopName(result.stop)},
+               {"stop", std::string(queryStopName(result.stop))},
                {"sphere_tests", result.sphereTests},
                {"triangle_tests", result.triangleTests},
                {"min_level", result.minLevel},
@@ -123,7 +114,7 @@ int runQuery(const QueryOptions& options) {
   std::ostringstream text;
   text.precision(9);
   text << (result.colliding ? "colliding" : "not colliding") << ", " << result.contacts.size() << " contacts, "
-       << result.tests << " tests, " << (result.finished ? "finished" : std::string("stopped: ") + stopName(result.stop))
+       << result.tests << " tests, " << (result.finished ? "finished" : std::string("stopped: ") + std::string(queryStopName(result.stop)))
        << ", levels " << result.minLevel << ".." << result.maxLevel << ", " << result.seconds * 1e6 << " us\n";
   for (const Contact& c : result.contacts) {
     text << "  point " << c.point.x() << " " << c.point.y() << " " << c.point.z() << "  normal " << c.normal.x() << " "

@@ -63,6 +63,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <string_view>
 #include <vector>
 
 #include "clod/budget.h"
@@ -108,6 +109,9 @@ enum class QueryStop : std::uint8_t {
   kTestBudget = 1,///< QueryBudget::maxTests used up
   kDeadline = 2,  ///< QueryBudget::deadline passed
 };
+
+/// "finished", "test_budget" or "deadline": the name the CLI's JSON and the Python bindings use.
+std::string_view queryStopName(QueryStop stop) noexcept;
 
 /// One pair of the frontier the answer was built from (body-local node indices).
 struct FrontierPair {

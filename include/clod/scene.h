@@ -16,7 +16,8 @@
 // resource limits for every mesh file of the scene, defaults as there),
 // "bounds" {"min": [..], "max": [..]}, "bodies" [ ... ]. Body keys: "name", exactly one of
 // "mesh" (path relative to the scene file), "box" [hx,hy,hz] (half extents) or "sphere" r;
-// "position", "orientation" [w,x,y,z], "velocity", "angular_velocity", "torque" [x,y,z] (N m,
+// "position", "orientation" [w,x,y,z] (any finite, nonzero magnitude: normalised), "velocity",
+// "angular_velocity", "torque" [x,y,z] (N m,
 // world frame, constant: applyConstantTorques hands it to World::applyTorque before every step),
 // "density" or "mass"
 // (default density 1000; an open mesh gets the mass properties of its bounding box), "scale"

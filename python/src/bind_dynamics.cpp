@@ -15,21 +15,13 @@
 #include "clod/contact.h"
 #include "clod/degradation.h"
 #include "clod/mass_properties.h"
+#include "clod/quaternion.h"
 #include "clod/query.h"
 #include "clod/scene.h"
 #include "clod/world.h"
 
 namespace clod::python {
 namespace {
-
-const char* stopName(QueryStop stop) {
-  switch (stop) {
-    case QueryStop::kFinished: return "finished";
-    case QueryStop::kTestBudget: return "test_budget";
-    case QueryStop::kDeadline: return "deadline";
-  }
-  return "unknown";
-}
 
 /// QuerySettings from the keyword arguments shared by query and query_batch.
 QuerySettings querySettings(const std::string& model, std::optional<long long> budget, std::uint32_t maxContacts,
@@ -136,7 +128,7 @@ PyQueryResult packQueryResult(const QueryResult& r, ContactModel model) {
   out.frontierPairs = r.frontier.size();
   out.finished = r.finished;
   out.colliding = r.colliding;
-  out.stop = stopName(r.stop);
+  out.stop = std::string(queryStopName(r.stop));
   out.model = std::string(contactModelName(model));
   out.minLevel = r.minLevel;
   out.maxLevel = r.maxLevel;
@@ -337,8 +329,9 @@ BodyId addBody(PyWorld& w, const PyBake& shape, std::optional<double> mass, doub
   DoubleArray q = toDoubleArray(orientation, "orientation");
   if (q.size() != 4 || q.ndim() != 1) invalidArgument("orientation: expected a quaternion (w, x, y, z), got shape " + shapeText(q));
   requireFinite(q, "orientation", 4);
-  desc.orientation = Quat(q.data()[0], q.data()[1], q.data()[2], q.data()[3]);
-  if (!(desc.orientation.norm() > 1e-12)) invalidArgument("orientation: the quaternion is zero");
+  const std::optional<Quat> unit = unitQuaternion(q.data()[0], q.data()[1], q.data()[2], q.data()[3]);
+  if (!unit) invalidArgument("orientation: the quaternion is zero");
+  desc.orientation = *unit;
   desc.velocity = vec3Arg(velocity, "velocity");
   desc.angularVelocity = vec3Arg(angularVelocity, "angular_velocity");
   desc.restitution = restitution;

@@ -13,6 +13,7 @@
 #include "clod/mass_properties.h"
 #include "clod/mesh_io.h"
 #include "clod/primitives.h"
+#include "clod/quaternion.h"
 #include "clod/sphere_sampling.h"
 #include "clod/version.h"
 
@@ -115,11 +116,10 @@ Pose poseFromSeven(const double* v, const std::string& name) {
   for (int k = 0; k < 7; ++k) {
     if (!std::isfinite(v[k])) invalidArgument(name + ": pose value " + std::to_string(k) + " is not finite");
   }
-  const Quat q(v[3], v[4], v[5], v[6]);
-  const double norm = q.norm();
-  if (!(norm > 1e-12)) invalidArgument(name + ": the quaternion (qw, qx, qy, qz) is zero");
+  const std::optional<Quat> q = unitQuaternion(v[3], v[4], v[5], v[6]);
+  if (!q) invalidArgument(name + ": the quaternion (qw, qx, qy, qz) is zero");
   Pose pose;
-  pose.rotation = Quat(q.coeffs() / norm);
+  pose.rotation = *q;
   pose.translation = Vec3(v[0], v[1], v[2]);
   return pose;
 }

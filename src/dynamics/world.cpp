@@ -13,6 +13,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "clod/error.h"
+#include "clod/quaternion.h"
 #include "clod/query.h"
 #include "narrowphase/separation.h"
 
@@ -373,12 +374,13 @@ BodyId World::addBody(const RigidBodyDesc& d) {
   if (!finite(d.position) || !finite(d.velocity) || !finite(d.angularVelocity) || !d.orientation.coeffs().allFinite() ||
       !finite(d.centerOfMass))
     bad("state must be finite");
-  if (d.orientation.norm() < 1e-12) bad("orientation quaternion is zero");
+  const std::optional<Quat> orientation = unitQuaternion(d.orientation.w(), d.orientation.x(), d.orientation.y(), d.orientation.z());
+  if (!orientation) bad("orientation quaternion is zero");
   Body b;
   b.desc = d;
   b.type = d.type;
   b.comLocal = d.centerOfMass;
-  b.q = d.orientation.normalized();
+  b.q = *orientation;
   b.desc.orientation = b.q;
   b.x = d.position + b.q * b.comLocal;
   b.localBox = d.shape->mesh().bounds();

@@ -2313,4 +2313,13 @@ QueryResult queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, cons
   return result;
 }
 
+std::string_view queryStopName(QueryStop stop) noexcept {
+  switch (stop) {
+    case QueryStop::kFinished: return "finished";
+    case QueryStop::kTestBudget: return "test_budget";
+    case QueryStop::kDeadline: return "deadline";
+  }
+  return "unknown";
+}
+
 }  // namespace clod

@@ -20,6 +20,7 @@
 #include "clod/mesh_io.h"
 #include "clod/primitives.h"
 #include "clod/proximity.h"
+#include "clod/quaternion.h"
 #include "clod/sphere_tree_builder.h"
 
 namespace clod {
@@ -130,8 +131,9 @@ SceneBody parseBody(const Reader& r, const Json& j, const std::string& path, con
   if (j.contains("position")) b.position = r.vec<3>(j["position"], path + ".position");
   if (j.contains("orientation")) {
     const Eigen::Vector4d q = r.vec<4>(j["orientation"], path + ".orientation");
-    if (q.norm() < 1e-9) r.fail(path + ".orientation", "quaternion [w,x,y,z] must not be zero");
-    b.orientation = Quat(q[0], q[1], q[2], q[3]).normalized();
+    const std::optional<Quat> unit = unitQuaternion(q[0], q[1], q[2], q[3]);
+    if (!unit) r.fail(path + ".orientation", "quaternion [w,x,y,z] must not be zero");
+    b.orientation = *unit;
   }
   if (j.contains("velocity")) b.velocity = r.vec<3>(j["velocity"], path + ".velocity");
   if (j.contains("angular_velocity")) b.angularVelocity = r.vec<3>(j["angular_velocity"], path + ".angular_velocity");

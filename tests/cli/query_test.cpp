@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -70,6 +71,39 @@ TEST_F(QueryCli, ExactBoxRestingOnBoxGivesTheFaceNormalAndTheDepth) {
     EXPECT_NEAR(c.at("point")[2].get<double>(), 0.995, 0.005 + 1e-9);
     EXPECT_TRUE(c.contains("level"));
   }
+}
+
+// A pose's quaternion is a direction: any finite, nonzero magnitude is the rotation it points
+// to. (1e200, 1e200, 0, 0) overflowed the norm and was refused as "not finite or a zero rotation
+// quaternion"; (1e-13, 0, 0, 0) was refused as zero. Oracle: the same query with the quaternion
+// written at unit scale. The scaled decimals round differently, so the rotations agree to a few
+// ulps, and every number within 1e-9 (the cube's diagonal is 3.5; the answers move by ~1e-15).
+TEST_F(QueryCli, QuaternionsOfAnyFiniteNonzeroMagnitudeAreTheirRotation) {
+  auto contacts = [](const std::string& quaternion) {
+    const CliRun run = runCli(pair() + "--pose-a \"0.3 0.2 1.99 " + quaternion + "\" --model exact --json");
+    EXPECT_EQ(run.exitCode, 0) << quaternion << ": " << run.err;
+    return run.exitCode == 0 ? nlohmann::json::parse(run.out).at("contacts") : nlohmann::json::array();
+  };
+  // The same contacts, in any order (the manifold's order among equal depths may follow an ulp).
+  auto expectSame = [](const nlohmann::json& got, const nlohmann::json& want, const std::string& what) {
+    ASSERT_EQ(got.size(), want.size()) << what;
+    auto same = [](const nlohmann::json& a, const nlohmann::json& b) {
+      bool close = std::abs(a.at("depth").get<double>() - b.at("depth").get<double>()) <= 1e-9;
+      for (int k = 0; k < 3; ++k) {
+        close = close && std::abs(a.at("point")[k].get<double>() - b.at("point")[k].get<double>()) <= 1e-9;
+        close = close && std::abs(a.at("normal")[k].get<double>() - b.at("normal")[k].get<double>()) <= 1e-9;
+      }
+      return close;
+    };
+    for (const auto& w : want)
+      EXPECT_TRUE(std::any_of(got.begin(), got.end(), [&](const nlohmann::json& g) { return same(g, w); }))
+          << what << ": no contact like " << w.dump();
+  };
+  const nlohmann::json turned = contacts("0.9 0.1 0 0");
+  ASSERT_FALSE(turned.empty());
+  expectSame(contacts("0.9e200 0.1e200 0 0"), turned, "1e200");
+  expectSame(contacts("0.9e-200 0.1e-200 0 0"), turned, "1e-200");
+  expectSame(contacts("1e-13 0 0 0"), contacts("1 0 0 0"), "1e-13");
 }
 
 TEST_F(QueryCli, BudgetIsRespectedAndSeparatedBodiesDoNotCollide) {

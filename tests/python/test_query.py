@@ -195,6 +195,18 @@ def test_matrix_and_quaternion_poses_agree(sphere_bake):
     np.testing.assert_allclose(a.pos, b.pos, atol=1e-12 * sphere_bake.diagonal)
 
 
+def test_quaternions_of_any_finite_nonzero_magnitude_are_their_rotation(sphere_bake):
+    # (0.9e200, 0.1e200, ...) overflowed the norm and was refused: it is the unit pose's rotation.
+    unit = np.array([1.2, 0.9, 0.3, 0.9, 0.1, -0.3, 0.2])
+    for scale in (1e200, 1e-200):
+        scaled = np.concatenate([unit[:3], unit[3:] * scale])
+        a = clod.query(sphere_bake, IDENTITY, sphere_bake, unit, model="exact")
+        b = clod.query(sphere_bake, IDENTITY, sphere_bake, scaled, model="exact")
+        assert len(a) == len(b) > 0
+        # The scaled decimals round differently: the same rotation to a few ulps (1e-12 of the diagonal).
+        np.testing.assert_allclose(a.pos, b.pos, atol=1e-12 * sphere_bake.diagonal)
+
+
 def test_bad_query_arguments_are_refused(box_bake):
     no_cfm = clod.bake(clod.Mesh.box([1, 1, 1]), sphere_tree="octree", levels=1, closest_feature_map=False,
                        contact_tree=False, measure_fit=False)

@@ -1,3 +1,4 @@
+#include <cmath>
 #include <filesystem>
 #include <string>
 
@@ -105,6 +106,20 @@ TEST(SceneBuild, GivenMassAndAnalyticBoxInertiaReachTheWorld) {
   // Solid box: I_xx = m/3 (hy^2 + hz^2) = 2 * (1 + 2.25) = 6.5 (half extents).
   EXPECT_NEAR(world.desc(0).inertia(0, 0), 6.5, 1e-9);
   EXPECT_NEAR(world.desc(0).inertia(2, 2), 2.0 * (0.25 + 1.0), 1e-9);
+}
+
+// An orientation is a direction: [0, 0, 1e300, 1e300], whose norm overflows, is the half turn
+// about (0, 1, 1) / sqrt 2 -- it was normalised to zero and refused by the world -- and
+// [1e-10, 0, 0, 0] is the identity (refused as zero before). Oracle: the unit quaternions by hand.
+TEST(SceneParse, OrientationsOfAnyFiniteNonzeroMagnitudeAreTheirRotation) {
+  const SceneDescription s = parseScene(
+      R"({"bodies": [{"box": [1,1,1], "orientation": [0, 0, 1e300, 1e300]}, {"box": [1,1,1], "orientation": [1e-10, 0, 0, 0]}]})",
+      ".", "t.json");
+  ASSERT_EQ(s.bodies.size(), 2u);
+  EXPECT_NEAR(s.bodies[0].orientation.w(), 0.0, 1e-15);
+  EXPECT_NEAR(s.bodies[0].orientation.y(), std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(s.bodies[0].orientation.z(), std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(s.bodies[1].orientation.w(), 1.0, 1e-15);
 }
 
 TEST(SceneParse, TorqueMustBeThreeNumbers) {
