@@ -21,6 +21,14 @@ namespace clod {
 /// 1e-7 d). Triangles with two equal corner indices are always degenerate.
 inline constexpr double kDegenerateCrossRel = 1e-14;
 
+/// The bounding-box diagonals (mesh units) clod computes with. Lengths are squared (areas,
+/// distances) and raised to the fifth power (a solid's inertia) in double and baked in float, so
+/// far outside this range answers overflow or underflow: a box of half extent 1e200 got a
+/// sphere-tree radius of infinity, a sphere of radius 1e-300 "zero-area" triangles. Between
+/// them every product clod forms stays finite and normal (1e12^5 = 1e60; 1e-12^5 = 1e-60).
+inline constexpr double kMinMeshDiagonal = 1e-12;
+inline constexpr double kMaxMeshDiagonal = 1e12;
+
 /// One finding of validateMesh.
 struct MeshIssue {
   /// Set for fatal findings (the ErrorCode requireValidMesh throws); empty for warnings.
@@ -88,14 +96,15 @@ inline constexpr std::uint32_t kMaxListedIssues = 20;
 
 /// Checks a mesh and reports every finding, fatal or not. Never throws for bad data (only
 /// std::bad_alloc). Fatal findings: non-finite coordinates (kNonFiniteVertex), out-of-range
-/// indices (kIndexOutOfRange), no triangles (kNoTriangles), every triangle degenerate
+/// indices (kIndexOutOfRange), no triangles (kNoTriangles), a bounding-box diagonal outside
+/// [kMinMeshDiagonal, kMaxMeshDiagonal] (kUnsupportedMesh), every triangle degenerate
 /// (kAllTrianglesDegenerate). Warnings: open, non-manifold edges/vertices, degenerate or
 /// duplicate triangles, unreferenced vertices, several components, inconsistent orientation,
 /// inside-out, flat (zero extent along an axis, or a closed mesh enclosing zero volume). Complexity: O(V + T log T) time, O(V + T) memory.
 MeshReport validateMesh(const TriangleMesh& mesh);
 
 /// Throws clod::Error for the first fatal finding of `report` (in the order non-finite vertex,
-/// out-of-range index, no triangles, all degenerate), with the message of that finding plus a
+/// out-of-range index, no triangles, size out of range, all degenerate), with the message of that finding plus a
 /// count of further fatal findings. Does nothing when report.usable().
 void throwIfUnusable(const MeshReport& report);
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <numeric>
+#include <sstream>
+#include <string>
 
 #include "clod/mesh_topology.h"
 
@@ -82,8 +84,17 @@ MeshReport validateMesh(const TriangleMesh& mesh) {
   }
   if (r.outOfRangeTriangles > 0) return r;  // topology needs valid indices
 
-  // --- degenerate triangles ---
+  // --- size: the range clod computes with (kMinMeshDiagonal, mesh_validation.h) ---
   const double diagonal = r.bounds.diagonal();
+  if (r.nonFiniteVertices == 0 && !(diagonal >= kMinMeshDiagonal && diagonal <= kMaxMeshDiagonal)) {
+    std::ostringstream text;
+    text << "bounding-box diagonal " << diagonal << " is outside the supported range [" << kMinMeshDiagonal << ", "
+         << kMaxMeshDiagonal << "] (mesh units): scale the mesh";
+    fatal(ErrorCode::kUnsupportedMesh, text.str());
+    return r;
+  }
+
+  // --- degenerate triangles ---
   const double crossLimit = kDegenerateCrossRel * diagonal * diagonal;
   std::uint32_t firstDegenerate = 0;
   for (std::uint32_t t = 0; t < r.triangleCount; ++t) {

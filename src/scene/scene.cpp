@@ -18,6 +18,7 @@
 #include "clod/error.h"
 #include "clod/mass_properties.h"
 #include "clod/mesh_io.h"
+#include "clod/mesh_validation.h"
 #include "clod/primitives.h"
 #include "clod/proximity.h"
 #include "clod/quaternion.h"
@@ -307,6 +308,13 @@ World buildWorld(const SceneDescription& scene, const std::filesystem::path& cac
     const std::string key = std::string(name) + (needContactTree ? "-ct" + std::to_string(sb.bake.contactTreeDepth) : "");
     auto found = shapes.find(key);
     if (found == shapes.end()) {
+      // Checked before the bake so that a fatal finding names its body (a primitive or a scaled
+      // mesh whose size is out of range: the bake's own check knows only the mesh).
+      try {
+        requireValidMesh(mesh);
+      } catch (const Error& e) {
+        throw Error(e.code(), "body " + std::to_string(i) + " '" + sb.name + "': " + e.what());
+      }
       const auto t0 = std::chrono::steady_clock::now();
       std::optional<BakeContents> contents;
       const std::filesystem::path cached = cacheDir.empty() ? std::filesystem::path() : cacheDir / name;

@@ -114,6 +114,18 @@ TEST_F(HostileInput, UnknownFlagsAndMissingArgumentsAreUsageErrorsInTheCommonFor
   EXPECT_NE(help.out.find("--deadline-us"), std::string::npos);
 }
 
+// Shapes of absurd size: a sphere of radius 1e300 was "every triangle of the mesh has zero area"
+// (its areas overflowed), a box of half extent 1e200 a sphere-tree radius of infinity reported as
+// a usage error. The size range is a fatal finding of the mesh (kMinMeshDiagonal), naming the body.
+TEST_F(HostileInput, ShapesOfAbsurdSizeAreUnsupportedMeshesNamingTheirBody) {
+  for (const char* shape : {R"("sphere": 1e300)", R"("box": [1e200, 1, 1])", R"("sphere": 1e-300)"}) {
+    std::ofstream(dir_ / "huge.json") << R"({"steps": 1, "bodies": [{"name": "giant", )" << shape << "}]}";
+    expectError(runCli("simulate " + quoted(dir_ / "huge.json") + " -o " + quoted(dir_ / "out")), 1, "unsupported_mesh",
+                "body 0 'giant': bounding-box diagonal");
+    EXPECT_FALSE(fs::exists(dir_ / "out" / "trajectory.csv")) << shape;
+  }
+}
+
 TEST_F(HostileInput, BodyNamesAreQuotedInTheCsvFiles) {
   std::ofstream(dir_ / "scene.json") << R"({"steps": 2, "bodies": [
       {"name": "ground, \"flat\"", "box": [2, 2, 0.25], "static": true, "bake": {"depth": 1}},

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -186,6 +187,24 @@ TEST(ValidateMesh, AllTrianglesDegenerateIsFatal) {
   mesh.vertices = {Vec3(0, 0, 0), Vec3(1, 1, 1), Vec3(2, 2, 2), Vec3(0.3, 0.3, 0.3)};
   mesh.triangles = {{0, 1, 2}, {1, 2, 3}, {0, 0, 1}};
   EXPECT_EQ(thrownCode(mesh), ErrorCode::kAllTrianglesDegenerate);
+}
+
+// Boxes scaled so that their diagonal lies just inside and just outside [kMinMeshDiagonal,
+// kMaxMeshDiagonal]: inside they are valid closed boxes, outside the size is the fatal finding
+// (a 1e200 box's sphere-tree radius overflowed to infinity, a 1e-300 sphere's triangles read as
+// zero-area). Oracle: the box's diagonal, 2 sqrt(3) times its half extent.
+TEST(ValidateMesh, SizesOutsideTheSupportedRangeAreFatal) {
+  const double unitDiagonal = 2.0 * std::sqrt(3.0);
+  for (double diagonal : {1.01 * kMinMeshDiagonal, 0.99 * kMaxMeshDiagonal}) {
+    const MeshReport report = validateMesh(makeBox(Vec3::Constant(diagonal / unitDiagonal)));
+    EXPECT_TRUE(report.usable()) << diagonal;
+    EXPECT_TRUE(report.closed) << diagonal;
+  }
+  for (double diagonal : {0.99 * kMinMeshDiagonal, 1.01 * kMaxMeshDiagonal, 1e-300, 1e300}) {
+    std::string message;
+    EXPECT_EQ(thrownCode(makeBox(Vec3::Constant(diagonal / unitDiagonal)), &message), ErrorCode::kUnsupportedMesh) << diagonal;
+    EXPECT_NE(message.find("outside the supported range"), std::string::npos) << message;
+  }
 }
 
 TEST(ValidateMesh, FlatSquareLoadsAsOpenNotFatal) {
