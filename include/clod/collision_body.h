@@ -117,9 +117,11 @@ public:
   /// separating-axis test over the patch's face normals and edge-edge axes gives the true
   /// penetration depth, and the cfm model's contacts from such a pair carry no error from this
   /// side (docs/narrow-phase.md, "Faceted pairs").
+  /// A tessellated convex polyhedron (a box whose faces are split into many triangles) counts:
+  /// such a patch lists only the body's corners (vertices on three or more face planes), since
+  /// vertices inside a face or along an edge are never extreme along any axis.
   bool patchIsWholeConvexBody(std::uint32_t sphere) const noexcept {
-    return convexPolyhedron_ && spherePatchVertices(sphere).size() == usedVertexCount_ &&
-           !sphereEdgeDirections(sphere).empty();
+    return convexPolyhedron_ && wholeBodyPatch_[sphere] != 0 && !sphereEdgeDirections(sphere).empty();
   }
   /// True when the mesh is a closed convex polyhedron (every vertex behind every triangle's
   /// plane; checked for meshes of at most kMaxConvexCheckTriangles triangles, false above). Then
@@ -177,6 +179,7 @@ private:
   bool convexPolyhedron_ = false;     // closed and convex (isConvexPolyhedron)
   bool closed_ = false;               // every edge shared by exactly two triangles (isClosed)
   std::size_t usedVertexCount_ = 0;   // distinct vertices referenced by triangles
+  std::vector<std::uint8_t> wholeBodyPatch_;  // per sphere: its patch holds every vertex (patchIsWholeConvexBody)
   std::string name_;
   struct LazyTriangleBvh;  // triangleBvh(): built once, on first use
   std::shared_ptr<LazyTriangleBvh> triangleBvh_;

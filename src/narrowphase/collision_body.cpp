@@ -122,6 +122,26 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree)
       i = j;
     }
   }
+  classifyConvexPolyhedron(edges);
+  // Corners of a convex polyhedron: vertices whose triangles lie in three or more planes (one
+  // plane: inside a face; two: along an edge). A patch of the whole body lists only these.
+  std::vector<std::uint8_t> corner;
+  if (convexPolyhedron_) {
+    std::vector<std::array<Vec3, 3>> planes(mesh_.vertices.size());
+    std::vector<std::uint8_t> planeCount(mesh_.vertices.size(), 0);
+    for (std::uint32_t t = 0; t < mesh_.triangleCount(); ++t) {
+      const Vec3 n = mesh_.triangleNormal(t);
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t v = mesh_.triangles[t][k];
+        std::uint8_t& count = planeCount[v];
+        bool known = false;
+        for (std::uint8_t j = 0; j < std::min<std::uint8_t>(count, 3); ++j) known = known || planes[v][j].dot(n) > 1.0 - 5e-13;
+        if (!known && count < 3) planes[v][count++] = n;
+      }
+    }
+    corner.resize(mesh_.vertices.size());
+    for (std::size_t v = 0; v < corner.size(); ++v) corner[v] = planeCount[v] >= 3;
+  }
   innerVertexOffsets_.assign(1, 0);
   std::vector<std::uint32_t> inner;
   for (std::uint32_t i = 0; i < tree_.sphereCount(); ++i) {
@@ -135,6 +155,7 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree)
       if (distinct.size() > kMaxSphereFaceNormals) break;
     }
     const bool faceted = !distinct.empty() && distinct.size() <= kMaxSphereFaceNormals;
+    bool whole = false;
     if (faceted) {
       for (const Vec3& d : distinct) faceNormals_.push_back(d.cast<float>());
       vertices.clear();
@@ -171,6 +192,10 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree)
       }
       std::sort(vertices.begin(), vertices.end());
       vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+      whole = vertices.size() == usedVertexCount_;
+      if (whole && convexPolyhedron_)
+        vertices.erase(std::remove_if(vertices.begin(), vertices.end(), [&](std::uint32_t v) { return !corner[v]; }),
+                       vertices.end());
       if (vertices.size() <= kMaxSpherePatchVertices) {
         patchVertices_.insert(patchVertices_.end(), vertices.begin(), vertices.end());
         if (edgeDirections.size() <= kMaxSphereEdgeDirections) {
@@ -179,6 +204,8 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree)
       }
     }
     edgeDirectionOffsets_.push_back(static_cast<std::uint32_t>(edgeDirections_.size()));
+    wholeBodyPatch_.push_back(whole && patchVertexOffsets_.size() > 0 &&
+                              patchVertices_.size() > patchVertexOffsets_.back());
     faceNormalOffsets_.push_back(static_cast<std::uint32_t>(faceNormals_.size()));
     patchVertexOffsets_.push_back(static_cast<std::uint32_t>(patchVertices_.size()));
     const bool hasPatch = patchVertexOffsets_[i + 1] > patchVertexOffsets_[i];
@@ -200,7 +227,6 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree)
     }
     innerVertexOffsets_.push_back(static_cast<std::uint32_t>(innerVertices_.size()));
   }
-  classifyConvexPolyhedron(edges);
   findNeighbours(edges);
   computeVertexNormals();
 }

@@ -718,7 +718,7 @@ TEST(World, TimeBudgetMustBeFiniteAndNonNegative) {
 // per frame than the budget, so the bound is not there by accident.
 TEST(World, BudgetCountsFrontierPairs) {
   const auto slab = bakeShape(makeBox(Vec3(3.0, 3.0, 0.25)));
-  const auto gridCube = bakeShape(test::makeGridBox(Vec3(0.5, 0.5, 0.5), 3));
+  const auto gridCube = bakeShape(test::makeGridBox(Vec3(0.5, 0.5, 0.5), 3, 0.05));
   // Eight cubes 1.1 m apart (0.1 m gaps) dropped from 0.05-0.4 m onto the slab.
   ContactModel model = ContactModel::kContactTree;
   auto run = [&](std::uint32_t cost, std::uint64_t& maxSampled, std::uint64_t& interrupted) {
@@ -729,9 +729,9 @@ TEST(World, BudgetCountsFrontierPairs) {
     World world(ws);
     addStaticGround(world, slab);
     for (int i = 0; i < 8; ++i) {
-      // cfm and the contact tree answer a 12-triangle cube's pairs with a slab at the root (both
-      // are whole convex polyhedra, nothing to refine): a cube with 3 x 3 squares per face has
-      // frontiers to grow.
+      // cfm and the contact tree answer a convex cube's pairs with a slab at the root (both are
+      // whole convex polyhedra, nothing to refine): a cube with 3 x 3 squares per face and a dent
+      // in its top has frontiers to grow.
       RigidBodyDesc box = dynamicBox(gridCube, Vec3(0.5, 0.5, 0.5), 1.0);
       box.position = Vec3(-1.65 + 1.1 * (i % 4), i < 4 ? -0.55 : 0.55, 0.8 + 0.05 * i);
       world.addBody(box);

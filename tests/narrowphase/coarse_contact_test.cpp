@@ -59,8 +59,9 @@ struct SlabBodies {
   // A 4 x 4 x 0.5 slab (top face at z = 0.25) and a unit cube, both centred at their origin.
   CollisionBody slab = bakeLikeTheWorldTest(makeBox(Vec3(2.0, 2.0, 0.25)));
   CollisionBody cube = bakeLikeTheWorldTest(makeBox(Vec3(0.5, 0.5, 0.5)));
-  // The same cube with 3 x 3 squares per face (56 vertices): not a whole-body patch.
-  CollisionBody gridCube = bakeLikeTheWorldTest(test::makeGridBox(Vec3(0.5, 0.5, 0.5), 3));
+  // The same cube with 3 x 3 squares per face (56 vertices) and a dent in its top: not convex,
+  // so not a whole-body patch.
+  CollisionBody gridCube = bakeLikeTheWorldTest(test::makeGridBox(Vec3(0.5, 0.5, 0.5), 3, 0.05));
 };
 
 const SlabBodies& slabBodies() {

@@ -15,6 +15,7 @@
 #include "clod/primitives.h"
 #include "clod/query.h"
 #include "narrowphase_test_support.h"
+#include "support/grid_box.h"
 
 namespace clod {
 namespace {
@@ -32,6 +33,10 @@ struct Bodies {
   // feature maps and contact trees (narrowphase_test_support.h).
   CollisionBody unit = test::makeTestBody(makeBox(Vec3::Constant(0.5)), 2);
   CollisionBody half = test::makeTestBody(makeBox(Vec3::Constant(0.25)), 2);
+  // The same cubes with every face split into 4 x 4 squares (98 vertices, 192 triangles): convex
+  // polyhedra whose faces are many triangles, as a CAD export or a remeshed box has them.
+  CollisionBody gridUnit = test::makeTestBody(test::makeGridBox(Vec3::Constant(0.5), 4), 2);
+  CollisionBody gridHalf = test::makeTestBody(test::makeGridBox(Vec3::Constant(0.25), 4), 2);
 };
 
 const Bodies& bodies() {
@@ -125,19 +130,18 @@ Pose bPose(const Configuration& c) {
 // flush side face; the analytic normal (0.01 deg) and depth (1e-6 of the diagonal); the deepest
 // penetration kept; the contacts at the corners of the overlap (an edge on a face: the edge's two
 // ends).
-TEST(FlushContact, EveryModelGivesTheAnalyticContactOfTwoBoxesAtFlushFaces) {
-  const Bodies& b = bodies();
+void expectAnalyticFlushContacts(const CollisionBody& unit, const CollisionBody& half) {
   const double diagonal = std::sqrt(3.0);
   // Every model answers two convex polyhedra from their faces (error bound 0): 0.01 deg and 1e-6
   // of the diagonal cover rounding only.
   const double normalTolerance = 0.01 * kDegree;
   const double depthRounding = 1e-6 * diagonal;
   for (const Configuration& config : configurations()) {
-    const CollisionBody& a = config.smallA ? b.half : b.unit;
+    const CollisionBody& a = config.smallA ? half : unit;
     for (ContactModel model : {ContactModel::kCfm, ContactModel::kExact, ContactModel::kContactTree})
     for (std::uint64_t budget : {std::uint64_t(16), kUnlimitedTests}) {
       const std::string what = config.name + ", " + std::string(contactModelName(model)) + " at " + std::to_string(budget);
-      const QueryResult r = queryContacts(a, config.poseA, b.unit, bPose(config), settingsFor(model, budget));
+      const QueryResult r = queryContacts(a, config.poseA, unit, bPose(config), settingsFor(model, budget));
       ASSERT_TRUE(r.finished) << what;
       ASSERT_FALSE(r.contacts.empty()) << what;
       dump(what, r);
@@ -169,6 +173,21 @@ TEST(FlushContact, EveryModelGivesTheAnalyticContactOfTwoBoxesAtFlushFaces) {
   }
 }
 
+
+TEST(FlushContact, EveryModelGivesTheAnalyticContactOfTwoBoxesAtFlushFaces) {
+  expectAnalyticFlushContacts(bodies().unit, bodies().half);
+}
+
+// The same with tessellated boxes. Their faces are many triangles, so their sphere-trees' root
+// patches held more than kMaxSpherePatchVertices vertices and no model saw two convex
+// polyhedra: the contact tree sampled their fields, and in the corner and on parallel edges gave
+// contacts 11 deg from a flush side's normal. A whole convex body's patch now lists its corners
+// alone (CollisionBody::patchIsWholeConvexBody), and every model answers as for 12 triangles.
+TEST(FlushContact, EveryModelGivesTheAnalyticContactOfTwoTessellatedBoxesAtFlushFaces) {
+  ASSERT_TRUE(bodies().gridUnit.patchIsWholeConvexBody(0));
+  EXPECT_EQ(bodies().gridUnit.spherePatchVertices(0).size(), 8u);
+  expectAnalyticFlushContacts(bodies().gridUnit, bodies().gridHalf);
+}
 
 }  // namespace
 }  // namespace clod

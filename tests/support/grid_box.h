@@ -7,11 +7,13 @@
 
 namespace clod::test {
 
-// A box whose faces are each split into n x n squares (two triangles each), welded: more than
-// CollisionBody::kMaxSpherePatchVertices vertices for n >= 3, so no sphere's patch is the whole
-// body and the exact model tests its triangles (a 12-triangle box is answered by the
-// separating-axis test of two convex polyhedra instead).
-inline TriangleMesh makeGridBox(const Vec3& half, int n) {
+// A box whose faces are each split into n x n squares (two triangles each), welded. Still a
+// convex polyhedron: its root patch lists the 8 corners, and two of them are answered by the
+// separating-axis test (CollisionBody::patchIsWholeConvexBody). With topDent > 0 the top face's
+// grid point (1, 1) is pushed that fraction of the half height into the box (n >= 2): no longer
+// convex, so the exact model tests its triangles and the contact tree samples its fields, while
+// the bottom face -- what rests on a floor -- stays flat.
+inline TriangleMesh makeGridBox(const Vec3& half, int n, double topDent = 0.0) {
   TriangleMesh mesh;
   std::map<std::array<long long, 3>, std::uint32_t> index;  // welded grid points, in units of 1/n
   auto vertex = [&](const std::array<int, 3>& g) {
@@ -46,6 +48,7 @@ inline TriangleMesh makeGridBox(const Vec3& half, int n) {
       }
     }
   }
+  if (topDent > 0.0) mesh.vertices[vertex({1, 1, n})].z() -= topDent * half.z();
   return mesh;
 }
 
