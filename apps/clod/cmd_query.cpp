@@ -114,7 +114,7 @@ int runQuery(const QueryOptions& options) {
   std::ostringstream text;
   text.precision(9);
   text << (result.colliding ? "colliding" : "not colliding") << ", " << result.contacts.size() << " contacts, "
-       << result.tests << " tests, " << (result.finished ? "finished" : std::string("stopped: ") + std::string(queryStopName(result.stop)))
+       << result.tests << " tests, " << (result.finished ? "finished" : "stopped: " + std::string(queryStopName(result.stop)))
        << ", levels " << result.minLevel << ".." << result.maxLevel << ", " << result.seconds * 1e6 << " us\n";
   for (const Contact& c : result.contacts) {
     text << "  point " << c.point.x() << " " << c.point.y() << " " << c.point.z() << "  normal " << c.normal.x() << " "

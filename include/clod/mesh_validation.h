@@ -104,8 +104,8 @@ inline constexpr std::uint32_t kMaxListedIssues = 20;
 MeshReport validateMesh(const TriangleMesh& mesh);
 
 /// Throws clod::Error for the first fatal finding of `report` (in the order non-finite vertex,
-/// out-of-range index, no triangles, size out of range, all degenerate), with the message of that finding plus a
-/// count of further fatal findings. Does nothing when report.usable().
+/// out-of-range index, no triangles, size out of range, all degenerate), with the message of that
+/// finding plus a count of further fatal findings. Does nothing when report.usable().
 void throwIfUnusable(const MeshReport& report);
 
 /// validateMesh + throwIfUnusable, for meshes built in code: returns the report when the mesh is

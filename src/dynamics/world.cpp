@@ -374,7 +374,8 @@ BodyId World::addBody(const RigidBodyDesc& d) {
   if (!finite(d.position) || !finite(d.velocity) || !finite(d.angularVelocity) || !d.orientation.coeffs().allFinite() ||
       !finite(d.centerOfMass))
     bad("state must be finite");
-  const std::optional<Quat> orientation = unitQuaternion(d.orientation.w(), d.orientation.x(), d.orientation.y(), d.orientation.z());
+  const Quat& q = d.orientation;
+  const std::optional<Quat> orientation = unitQuaternion(q.w(), q.x(), q.y(), q.z());
   if (!orientation) bad("orientation quaternion is zero");
   Body b;
   b.desc = d;

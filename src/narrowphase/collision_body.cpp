@@ -97,51 +97,38 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree)
     if (x.v0 != y.v0) return x.v0 < y.v0;
     return x.v1 != y.v1 ? x.v1 < y.v1 : x.triangle < y.triangle;
   });
-  // Vertices inside a flat region: every triangle around them has one normal (to ~1e-6 rad, as
-  // face normals are counted) and none of their edges is a border. Not counted as inner vertices.
-  std::vector<std::uint8_t> flatInside(mesh_.vertices.size(), 1);
+  // How many planes each vertex's triangles lie in (to ~1e-6 rad, as face normals are counted),
+  // counted up to 3; a zero-area triangle counts as a second plane. One plane: the vertex lies
+  // inside a flat region (when none of its edges is a border either; not counted as an inner
+  // vertex). Three or more on a convex polyhedron: a corner (two: along an edge), and a patch of
+  // the whole body lists only the corners.
+  std::vector<std::uint8_t> planeCount(mesh_.vertices.size(), 0);
   {
-    std::vector<Vec3> firstNormal(mesh_.vertices.size(), Vec3::Zero());
-    for (std::uint32_t t = 0; t < mesh_.triangleCount(); ++t) {
-      const Vec3 n = mesh_.triangleNormal(t);
-      for (int k = 0; k < 3; ++k) {
-        const std::uint32_t v = mesh_.triangles[t][k];
-        if (n.squaredNorm() == 0.0) {
-          flatInside[v] = 0;
-        } else if (firstNormal[v].squaredNorm() == 0.0) {
-          firstNormal[v] = n;
-        } else if (firstNormal[v].dot(n) <= 1.0 - 5e-13) {
-          flatInside[v] = 0;
-        }
-      }
-    }
-    for (std::size_t i = 0; i < edges.size();) {
-      std::size_t j = i;
-      while (j < edges.size() && edges[j].v0 == edges[i].v0 && edges[j].v1 == edges[i].v1) ++j;
-      if (j - i != 2) flatInside[edges[i].v0] = flatInside[edges[i].v1] = 0;
-      i = j;
-    }
-  }
-  classifyConvexPolyhedron(edges);
-  // Corners of a convex polyhedron: vertices whose triangles lie in three or more planes (one
-  // plane: inside a face; two: along an edge). A patch of the whole body lists only these.
-  std::vector<std::uint8_t> corner;
-  if (convexPolyhedron_) {
-    std::vector<std::array<Vec3, 3>> planes(mesh_.vertices.size());
-    std::vector<std::uint8_t> planeCount(mesh_.vertices.size(), 0);
+    std::vector<std::array<Vec3, 3>> planes(mesh_.vertices.size(), {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
     for (std::uint32_t t = 0; t < mesh_.triangleCount(); ++t) {
       const Vec3 n = mesh_.triangleNormal(t);
       for (int k = 0; k < 3; ++k) {
         const std::uint32_t v = mesh_.triangles[t][k];
         std::uint8_t& count = planeCount[v];
+        if (n.squaredNorm() == 0.0) {
+          count = std::max<std::uint8_t>(count, 2);
+          continue;
+        }
         bool known = false;
-        for (std::uint8_t j = 0; j < std::min<std::uint8_t>(count, 3); ++j) known = known || planes[v][j].dot(n) > 1.0 - 5e-13;
+        for (std::uint8_t j = 0; j < count; ++j) known = known || planes[v][j].dot(n) > 1.0 - 5e-13;
         if (!known && count < 3) planes[v][count++] = n;
       }
     }
-    corner.resize(mesh_.vertices.size());
-    for (std::size_t v = 0; v < corner.size(); ++v) corner[v] = planeCount[v] >= 3;
   }
+  std::vector<std::uint8_t> flatInside(mesh_.vertices.size());
+  for (std::size_t v = 0; v < flatInside.size(); ++v) flatInside[v] = planeCount[v] <= 1;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j].v0 == edges[i].v0 && edges[j].v1 == edges[i].v1) ++j;
+    if (j - i != 2) flatInside[edges[i].v0] = flatInside[edges[i].v1] = 0;
+    i = j;
+  }
+  classifyConvexPolyhedron(edges);
   innerVertexOffsets_.assign(1, 0);
   std::vector<std::uint32_t> inner;
   for (std::uint32_t i = 0; i < tree_.sphereCount(); ++i) {
@@ -194,7 +181,7 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree)
       vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
       whole = vertices.size() == usedVertexCount_;
       if (whole && convexPolyhedron_)
-        vertices.erase(std::remove_if(vertices.begin(), vertices.end(), [&](std::uint32_t v) { return !corner[v]; }),
+        vertices.erase(std::remove_if(vertices.begin(), vertices.end(), [&](std::uint32_t v) { return planeCount[v] < 3; }),
                        vertices.end());
       if (vertices.size() <= kMaxSpherePatchVertices) {
         patchVertices_.insert(patchVertices_.end(), vertices.begin(), vertices.end());
@@ -204,8 +191,7 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree)
       }
     }
     edgeDirectionOffsets_.push_back(static_cast<std::uint32_t>(edgeDirections_.size()));
-    wholeBodyPatch_.push_back(whole && patchVertexOffsets_.size() > 0 &&
-                              patchVertices_.size() > patchVertexOffsets_.back());
+    wholeBodyPatch_.push_back(whole && patchVertices_.size() > patchVertexOffsets_.back());  // and the patch was kept
     faceNormalOffsets_.push_back(static_cast<std::uint32_t>(faceNormals_.size()));
     patchVertexOffsets_.push_back(static_cast<std::uint32_t>(patchVertices_.size()));
     const bool hasPatch = patchVertexOffsets_[i + 1] > patchVertexOffsets_[i];
