@@ -45,6 +45,17 @@ constexpr double kMaxArrivalSubsteps = 8.0;
 // contact (World::Impl::arrivalTravel). At 60 Hz, 8 substeps let a mesh falling at 4 m/s, or a
 // tumbling fandisk's far corner, enter the floor 1.1-3.6 % of its diagonal before any contact.
 constexpr double kMaxApproachSubsteps = 16.0;
+// ... but never so few that the approach per substep exceeds this fraction of the smaller
+// diagonal (issue 17 allows a body 1 % inside another at any frame; the solver needs the first
+// contact shallower than that to push it out within the frame), up to maxSubsteps.
+constexpr double kMaxFirstContactRel = 0.008;
+
+// Substeps for the part of a pair's travel over a step that brings it together (`approach`,
+// World::Impl::arrivalTravel), the smaller body's diagonal `diag`: the capped rule, floored.
+double approachSubsteps(double approach, double diag) {
+  return std::max(std::min(approach / (kArrivalTravelRel * diag), kMaxApproachSubsteps),
+                  approach / (kMaxFirstContactRel * diag));
+}
 // Passes over each support layer's pairs in the shock-propagation sweep (World::Impl::solve). One
 // pass left a 1,000 kg box on a 1 kg box sliding at 5-7 cm/s after 3 s (friction and the four
 // corners are coupled through the rotation); 2 hold it (WorldMassRatio tests).
@@ -1508,7 +1519,7 @@ const StepReport& World::step(double dt) {
     const double diag = std::min(m.bodies[c[0]].desc.shape->diagonal(), m.bodies[c[1]].desc.shape->diagonal());
     const double unit = kArrivalTravelRel * diag;
     arrivalSubsteps = std::max({arrivalSubsteps, std::min((m.stepTravel[c[0]] + m.stepTravel[c[1]]) / unit, kMaxArrivalSubsteps),
-                                std::min(m.arrivalTravel(c, dt) / unit, kMaxApproachSubsteps)});
+                                approachSubsteps(m.arrivalTravel(c, dt), diag)});
   }
   std::uint32_t n = m.settings.minSubsteps;
   if (std::isfinite(minExtent) && maxTravel > 0.0) {
