@@ -5,7 +5,8 @@ speed at the end (docs/dynamics.md, "Known limits": millimetre meshes).
 
 usage: scripts/probe-scaled-drops.py MESHES SIZES MODELS BUDGETS OUTDIR
   MESHES: comma list of shared mesh names (bunny-1500,spot,fandisk); SIZES: diagonals in metres;
-  MODELS: cfm,exact,contact-tree,...; BUDGETS: tests per frame (0 = unlimited).
+  MODELS: cfm,exact,contact-tree,...; BUDGETS: tests per frame (0 = unlimited), or microseconds
+  per frame with a `us` suffix (200us).
   environment: RATES (60), J parallel runs (2), CLOD (build/bin/clod),
   CLOD_MESH_DIR (../shared/data/meshes).
 Each mesh is centred over a 4 x 4 x 0.5 diagonal box, turned 45 deg about x, its lowest point
@@ -38,7 +39,9 @@ def run(job):
     turned = [rotate(TURN, v) for v in local]
     centre = [(min(v[i] for v in turned) + max(v[i] for v in turned)) / 2 for i in range(2)]
     lowest = min(v[2] for v in turned)
-    scene = {"dt": 1.0 / rate, "duration": 4.0 * math.sqrt(max(size, 1.0)), "contact_model": model, "budget": budget,
+    timed = budget.endswith('us')
+    scene = {"dt": 1.0 / rate, "duration": 4.0 * math.sqrt(max(size, 1.0)), "contact_model": model,
+             "budget_us" if timed else "budget": float(budget[:-2]) if timed else int(budget),
              "bodies": [{"name": "ground", "box": [2 * size, 2 * size, 0.25 * size], "position": [0, 0, -0.25 * size],
                          "static": True, "friction": 0.6},
                         {"name": "mesh", "mesh": os.path.join(MESHES, mesh + '.obj'), "scale": scale,
@@ -68,7 +71,7 @@ def main():
         sys.exit(__doc__)
     meshes, sizes, models, budgets, outdir = sys.argv[1:]
     rates = [float(r) for r in os.environ.get('RATES', '60').split(',')]
-    jobs = [(m, float(s), model, int(b), rate, os.path.join(outdir, f'{m}_{s}_{model}_{b}_{rate:g}'))
+    jobs = [(m, float(s), model, b, rate, os.path.join(outdir, f'{m}_{s}_{model}_{b}_{rate:g}'))
             for m in meshes.split(',') for s in sizes.split(',') for model in models.split(',')
             for b in budgets.split(',') for rate in rates]
     failed = 0
