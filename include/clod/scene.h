@@ -7,7 +7,9 @@
 // "dt" (s, default 1/60), "steps" or "duration" (s; default 120 steps), "contact_model"
 // (contact.h names, default "cfm"), "budget" (tests per frame, 0 = unlimited), "budget_us"
 // (narrow-phase microseconds per frame, WorldSettings::budgetMicros, 0 = unlimited), "max_contacts",
-// "min_substeps" (WorldSettings::minSubsteps, default 1; tall stacks need ~8),
+// "max_substeps" (WorldSettings::maxSubsteps, 1..kMaxSceneSubsteps, default 128; caps every
+// substep rule, the arrival rule's first-contact floor included: docs/dynamics.md),
+// "min_substeps" (WorldSettings::minSubsteps, 1..max_substeps, default 1; tall stacks need ~8),
 // "min_substep_iterations" (WorldSettings::minSubstepIterations, 0..20, default 4),
 // "frontier_pair_cost" (WorldSettings::frontierPairCost, 0..1024, default 2),
 // "rolling_resistance" (WorldSettings::rollingResistanceRel, 0..1, default 0.003),
@@ -39,6 +41,10 @@
 #include "clod/world.h"
 
 namespace clod {
+
+/// The largest "max_substeps" a scene may ask for (each substep is a broad phase, queries and a
+/// solve: beyond this a step's cost is a runaway, not a setting).
+inline constexpr std::uint32_t kMaxSceneSubsteps = 4096;
 
 /// How a body's shape is baked (sphere-tree and contact-tree options).
 struct SceneBakeOptions {

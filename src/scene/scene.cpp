@@ -214,7 +214,7 @@ SceneDescription parseScene(std::string_view text, const std::filesystem::path& 
     // fuzz_scene_load): both are bad text, not a bug.
     throw Error(ErrorCode::kSceneError, fileName + ": not valid JSON: " + e.what());
   }
-  r.object(j, "", {"gravity", "dt", "steps", "duration", "contact_model", "budget", "budget_us", "max_contacts", "min_substeps",
+  r.object(j, "", {"gravity", "dt", "steps", "duration", "contact_model", "budget", "budget_us", "max_contacts", "max_substeps", "min_substeps",
                   "min_substep_iterations", "frontier_pair_cost", "rolling_resistance", "max_pairs", "max_cached_node_pairs", "mesh_limits",
                   "bounds", "bodies"});
   SceneDescription s;
@@ -242,6 +242,9 @@ SceneDescription parseScene(std::string_view text, const std::filesystem::path& 
     if (s.world.budgetMicros > 1e9) r.fail("budget_us", "must be at most 1e9 (microseconds per frame)");
   }
   if (j.contains("max_contacts")) s.world.maxContacts = std::uint32_t(r.count(j["max_contacts"], "max_contacts", 1, 1024));
+  // Substeps are the world's cost per step: more than kMaxSceneSubsteps is a runaway scene.
+  if (j.contains("max_substeps"))
+    s.world.maxSubsteps = std::uint32_t(r.count(j["max_substeps"], "max_substeps", 1, kMaxSceneSubsteps));
   if (j.contains("min_substeps"))
     s.world.minSubsteps = std::uint32_t(r.count(j["min_substeps"], "min_substeps", 1, s.world.maxSubsteps));
   if (j.contains("min_substep_iterations"))

@@ -50,6 +50,10 @@ TEST(SceneParse, OutOfRangeAndConflictingValuesAreErrors) {
   EXPECT_NE(sceneError(R"({"bodies": [], "min_substep_iterations": 21})").find("min_substep_iterations"),
             std::string::npos);
   EXPECT_NE(sceneError(R"({"bodies": [], "max_pairs": 0})").find("max_pairs"), std::string::npos);
+  EXPECT_NE(sceneError(R"({"bodies": [], "max_substeps": 0})").find("max_substeps"), std::string::npos);
+  EXPECT_NE(sceneError(R"({"bodies": [], "max_substeps": 4097})").find("max_substeps"), std::string::npos);
+  // min_substeps is bounded by the scene's own max_substeps, not the default.
+  EXPECT_NE(sceneError(R"({"bodies": [], "max_substeps": 4, "min_substeps": 5})").find("min_substeps"), std::string::npos);
   EXPECT_NE(sceneError(R"({"bodies": [], "max_cached_node_pairs": -1})").find("max_cached_node_pairs"), std::string::npos);
   EXPECT_NE(sceneError(R"({"bodies": [], "mesh_limits": {"max_triangles": 0}})").find("mesh_limits.max_triangles"),
             std::string::npos);
@@ -60,7 +64,7 @@ TEST(SceneParse, OutOfRangeAndConflictingValuesAreErrors) {
 
 TEST(SceneParse, ReadsEveryFieldAsWritten) {
   const SceneDescription s = parseScene(R"({"gravity": [0, 0, -1], "dt": 0.01, "duration": 0.5,
-      "contact_model": "exact", "budget": 64, "budget_us": 1500, "max_contacts": 4, "min_substeps": 3,
+      "contact_model": "exact", "budget": 64, "budget_us": 1500, "max_contacts": 4, "max_substeps": 32, "min_substeps": 3,
       "min_substep_iterations": 7, "frontier_pair_cost": 5, "max_pairs": 1000, "max_cached_node_pairs": 0,
       "mesh_limits": {"max_vertices": 11, "max_triangles": 22, "max_polygon_vertices": 33},
       "bodies": [{"name": "a", "box": [1, 2, 3], "static": true},
@@ -75,6 +79,7 @@ TEST(SceneParse, ReadsEveryFieldAsWritten) {
   EXPECT_EQ(s.world.budgetTests, 64u);
   EXPECT_EQ(s.world.budgetMicros, 1500.0);
   EXPECT_EQ(s.world.maxContacts, 4u);
+  EXPECT_EQ(s.world.maxSubsteps, 32u);
   EXPECT_EQ(s.world.minSubsteps, 3u);
   EXPECT_EQ(s.world.minSubstepIterations, 7u);
   EXPECT_EQ(s.world.frontierPairCost, 5u);
