@@ -9,7 +9,8 @@
 // (narrow-phase microseconds per frame, WorldSettings::budgetMicros, 0 = unlimited), "max_contacts",
 // "max_substeps" (WorldSettings::maxSubsteps, 1..kMaxSceneSubsteps, default 128; caps every
 // substep rule, the arrival rule's first-contact floor included: docs/dynamics.md),
-// "min_substeps" (WorldSettings::minSubsteps, 1..max_substeps, default 1; tall stacks need ~8),
+// "min_substeps" (WorldSettings::minSubsteps, 1..max_substeps, default 1; a stack gets a substep
+// per body up to 8 whatever it says),
 // "min_substep_iterations" (WorldSettings::minSubstepIterations, 0..20, default 4),
 // "frontier_pair_cost" (WorldSettings::frontierPairCost, 0..1024, default 2),
 // "rolling_resistance" (WorldSettings::rollingResistanceRel, 0..1, default 0.003),

@@ -202,12 +202,13 @@ struct WorldSettings {
   /// near a resting frame's instead of n times it (docs/dynamics.md). 0 = velocityIterations in
   /// every substep (the behaviour before).
   std::uint32_t minSubstepIterations = 4;
-  /// At least this many substeps per step, in [1, maxSubsteps]. Tall stacks need it: projected
-  /// Gauss-Seidel passes support down a stack of n bodies only about one body per iteration, and
-  /// smaller steps converge far better than more iterations at equal cost (Macklin et al., "Small
-  /// steps in physics simulation", SCA 2019). Measured on the 10-box stack (docs/dynamics.md): 1
-  /// substep rocks 0.13 m in 10 s, 8 substeps move the top box 1 mm. Each substep queries the
-  /// narrow phase again, so collision cost grows with it (the budget stays per step).
+  /// At least this many substeps per step, in [1, maxSubsteps]. A stack gets more on its own: a
+  /// substep per body of its tallest support chain, up to 8, each with velocityIterations --
+  /// projected Gauss-Seidel passes support down a stack of n bodies only about one body per
+  /// iteration, and smaller steps converge far better than more iterations at equal cost
+  /// (Macklin et al., "Small steps in physics simulation", SCA 2019; docs/dynamics.md, "One
+  /// step"). Each substep queries the narrow phase again, so collision cost grows with it (the
+  /// budget stays per step).
   std::uint32_t minSubsteps = 1;
   /// Bodies whose centre of mass leaves this box are reported in StepReport::leftBounds
   /// (once, when they leave) and then frozen (made static) so they cannot run off to infinity.

@@ -60,6 +60,13 @@ double approachSubsteps(double approach, double diag) {
 // pass left a 1,000 kg box on a 1 kg box sliding at 5-7 cm/s after 3 s (friction and the four
 // corners are coupled through the rotation); 2 hold it (WorldMassRatio tests).
 constexpr std::uint32_t kShockPasses = 2;
+// Least substeps for a stack (World::step): as many as the bodies in its tallest support chain,
+// up to this, each with the full velocityIterations. Projected Gauss-Seidel passes support down a
+// stack about one body per iteration, and smaller steps converge far better than more iterations
+// at equal cost (Macklin et al., "Small steps in physics simulation", SCA 2019): at one substep
+// per 60 Hz frame a tower of five boxes whose middle one is 40 times heavier than the one under
+// it shook at up to 13 cm/s for good; at its five substeps it stands still.
+constexpr std::uint32_t kMaxStackSubsteps = 8;
 
 bool finite(const Vec3& v) { return v.allFinite(); }
 
@@ -318,6 +325,7 @@ struct World::Impl {
   // substep's contact graph and the pairs between different layers, bottom-up.
   void orderSupportLayers();
   std::vector<std::uint32_t> supportLayer, layerQueue, adjacencyStart, adjacency;
+  std::uint32_t tallestSupport = 0;  // the highest support layer of the last substep (World::step)
   std::vector<std::uint8_t> carries;  // a body is the lower one of some pair between two layers
   std::vector<std::uint32_t> shockPairs;  // indices into solveOrder, by lower layer
   void persistContacts(PairState& p, const Body& a, const Body& b, double diag);
@@ -1351,6 +1359,7 @@ void World::Impl::orderSupportLayers() {
       layerQueue.push_back(j);
     }
   }
+  tallestSupport = layerQueue.empty() ? 0 : supportLayer[layerQueue.back()];
   // A body on an immovable one that carries nothing is solved by the iterations exactly as the
   // sweep would solve it (the immovable side has no mass to share): such pairs are left out, so a
   // single body resting or sliding on the ground is solved as before.
@@ -1521,7 +1530,11 @@ const StepReport& World::step(double dt) {
     arrivalSubsteps = std::max({arrivalSubsteps, std::min((m.stepTravel[c[0]] + m.stepTravel[c[1]]) / unit, kMaxArrivalSubsteps),
                                 approachSubsteps(m.arrivalTravel(c, dt), diag)});
   }
-  std::uint32_t n = m.settings.minSubsteps;
+  // At least minSubsteps, and a substep per body of the tallest stack, up to kMaxStackSubsteps
+  // (the support layers of the last substep's contact graph; docs/dynamics.md, "One step").
+  const std::uint32_t leastSubsteps =
+      std::clamp(std::min(m.tallestSupport, kMaxStackSubsteps), m.settings.minSubsteps, m.settings.maxSubsteps);
+  std::uint32_t n = leastSubsteps;
   if (std::isfinite(minExtent) && maxTravel > 0.0) {
     const double want =
         std::ceil(std::max(arrivalSubsteps, maxTravel / (kTravelFraction * minExtent)));
@@ -1530,9 +1543,10 @@ const StepReport& World::step(double dt) {
   m.report.substeps = n;
   m.velocityIterationsNow = m.settings.velocityIterations;
   if (m.settings.minSubstepIterations > 0) {
-    // velocityIterations per substep at minSubsteps substeps; a step that needs more substeps
-    // (fast bodies) spreads the same iterations over them, at least minSubstepIterations each.
-    const std::uint64_t perStep = std::uint64_t(m.settings.velocityIterations) * m.settings.minSubsteps;
+    // velocityIterations per substep at the least substeps (minSubsteps, or a stack's); a step
+    // that needs more substeps (fast bodies) spreads the same iterations over them, at least
+    // minSubstepIterations each.
+    const std::uint64_t perStep = std::uint64_t(m.settings.velocityIterations) * leastSubsteps;
     m.velocityIterationsNow = std::uint32_t(std::min<std::uint64_t>(
         m.settings.velocityIterations, std::max<std::uint64_t>(m.settings.minSubstepIterations, (perStep + n - 1) / n)));
   }
