@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <charconv>
+#include <limits>
+#include <optional>
+#include <vector>
 
 #include "clod/error.h"
 #include "text_index_check.h"
@@ -108,6 +111,161 @@ void checkPlyCounts(std::string_view text, const std::string& source, const Mesh
   });
 }
 
+// PLY's structure, walked before the importer reads the data: the importer sizes each list by the
+// count a row gives (a face row declaring 10^70 corners made it ask for 26 GB), so every list
+// count, ASCII or binary, is held against maxPolygonVertices first. The header must be PLY's own
+// (keywords, scalar types: Turk's format as the importer knows it) -- an unknown keyword or type
+// made the importer read the rows under another layout. Rows past the end of the bytes are the
+// importer's to report.
+struct PlyProperty {
+  int countBytes = 0;  // a list's count type (0: a scalar)
+  int itemBytes = 0;   // a scalar's type, or a list item's
+  bool integerCount = true;
+};
+struct PlyElement {
+  std::uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+// Bytes of a PLY scalar type, 0 if the name is none; `integer` says whether it holds integers.
+int plyTypeBytes(std::string_view type, bool& integer) {
+  integer = true;
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "int" || type == "uint" || type == "int32" || type == "uint32") return 4;
+  integer = false;
+  if (type == "float" || type == "float32") return 4;
+  if (type == "double" || type == "float64") return 8;
+  return 0;
+}
+
+std::vector<std::string_view> tokensOf(std::string_view line) {
+  std::vector<std::string_view> tokens;
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && isBlank(line[i])) ++i;
+    const std::size_t start = i;
+    while (i < line.size() && !isBlank(line[i])) ++i;
+    if (i > start) tokens.push_back(line.substr(start, i - start));
+  }
+  return tokens;
+}
+
+void checkPlyLists(std::string_view text, const std::string& source, const MeshLoadOptions& options) {
+  std::vector<PlyElement> elements;
+  enum class Encoding { kAscii, kLittle, kBig } encoding = Encoding::kAscii;
+  std::size_t dataStart = text.size();
+  std::size_t lineNumber = 0, pos = 0;
+  auto bad = [&](const std::string& what) {
+    throw Error(ErrorCode::kParseError, lineLabel(source, lineNumber) + ": PLY header: " + what);
+  };
+  while (pos < text.size()) {
+    std::size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    const std::string_view line = text.substr(pos, end - pos);
+    pos = end + 1;
+    ++lineNumber;
+    const std::vector<std::string_view> t = tokensOf(line);
+    if (t.empty()) continue;
+    const std::string_view keyword = t[0];
+    if (keyword == "end_header") {
+      dataStart = std::min(pos, text.size());
+      break;
+    }
+    if (keyword == "ply" || keyword == "comment" || keyword == "obj_info") continue;
+    if (keyword == "format") {
+      if (t.size() < 2) bad("'format' without an encoding");
+      if (t[1] == "ascii") encoding = Encoding::kAscii;
+      else if (t[1] == "binary_little_endian") encoding = Encoding::kLittle;
+      else if (t[1] == "binary_big_endian") encoding = Encoding::kBig;
+      else bad("unknown encoding '" + std::string(t[1]) + "'");
+    } else if (keyword == "element") {
+      std::uint64_t count = 0;
+      if (t.size() != 3 || std::from_chars(t[2].data(), t[2].data() + t[2].size(), count).ptr != t[2].data() + t[2].size())
+        bad("'element' needs a name and a count");
+      elements.push_back({count, {}});
+    } else if (keyword == "property") {
+      if (elements.empty()) bad("a property before any element");
+      PlyProperty property;
+      bool integer = false;
+      if (t.size() == 5 && t[1] == "list") {
+        property.countBytes = plyTypeBytes(t[2], property.integerCount);
+        property.itemBytes = plyTypeBytes(t[3], integer);
+        if (property.countBytes == 0 || property.itemBytes == 0 || !property.integerCount)
+          bad("a list property needs an integer count type and an item type");
+      } else if (t.size() == 3) {
+        property.itemBytes = plyTypeBytes(t[1], integer);
+        if (property.itemBytes == 0) bad("unknown type '" + std::string(t[1]) + "'");
+      } else {
+        bad("'property' needs a type and a name, or 'list', two types and a name");
+      }
+      elements.back().properties.push_back(property);
+    } else {
+      std::string shown(keyword.substr(0, 32));
+      for (char& c : shown)
+        if (c < 0x20 || c > 0x7e) c = '?';
+      bad("unknown keyword '" + shown + "'");
+    }
+  }
+  const std::string where = source + ": PLY data";
+  auto checkCount = [&](std::uint64_t corners) {
+    enforceLimit(corners, options.maxPolygonVertices, "maxPolygonVertices", "entries in one list", where);
+  };
+  if (encoding == Encoding::kAscii) {
+    std::size_t at = dataStart;
+    auto nextToken = [&]() -> std::optional<std::string_view> {
+      while (at < text.size() && (isBlank(text[at]) || text[at] == '\n')) ++at;
+      const std::size_t start = at;
+      while (at < text.size() && !isBlank(text[at]) && text[at] != '\n') ++at;
+      if (at == start) return std::nullopt;
+      return text.substr(start, at - start);
+    };
+    for (const PlyElement& element : elements)
+      for (std::uint64_t row = 0; row < element.count; ++row)
+        for (const PlyProperty& property : element.properties) {
+          const std::optional<std::string_view> token = nextToken();
+          if (!token) return;  // truncated: the importer's to report
+          if (property.countBytes == 0) continue;
+          std::uint64_t count = 0;
+          const auto [end, ec] = std::from_chars(token->data(), token->data() + token->size(), count);
+          if (ec == std::errc::result_out_of_range) count = std::numeric_limits<std::uint64_t>::max();
+          else if (ec != std::errc() || end != token->data() + token->size())
+            throw Error(ErrorCode::kParseError, where + ": a list count is not a non-negative integer ('" +
+                                                    std::string(token->substr(0, 32)) + "')");
+          checkCount(count);
+          for (std::uint64_t k = 0; k < count; ++k)
+            if (!nextToken()) return;
+        }
+    return;
+  }
+  std::size_t at = dataStart;
+  auto readCount = [&](int bytes) {
+    std::uint64_t value = 0;
+    for (int b = 0; b < bytes; ++b) {
+      const int shift = encoding == Encoding::kLittle ? 8 * b : 8 * (bytes - 1 - b);
+      value |= std::uint64_t(static_cast<unsigned char>(text[at + std::size_t(b)])) << shift;
+    }
+    at += std::size_t(bytes);
+    return value;
+  };
+  for (const PlyElement& element : elements)
+    for (std::uint64_t row = 0; row < element.count; ++row)
+      for (const PlyProperty& property : element.properties) {
+        if (property.countBytes == 0) {
+          if (text.size() - at < std::size_t(property.itemBytes)) return;
+          at += std::size_t(property.itemBytes);
+          continue;
+        }
+        if (text.size() - at < std::size_t(property.countBytes)) return;
+        std::uint64_t count = readCount(property.countBytes);
+        // A signed count type's negative values read as huge ones here: refused either way.
+        checkCount(count);
+        const std::uint64_t bytes = count * std::uint64_t(property.itemBytes);
+        if (text.size() - at < bytes) return;
+        at += std::size_t(bytes);
+      }
+}
+
 // The command-line flag (separator '-') or scene key ('_') of a MeshLoadOptions limit:
 // maxPolygonVertices -> max-polygon-vertices / max_polygon_vertices.
 std::string flagName(std::string_view option, char separator) {
@@ -136,7 +294,10 @@ void enforceLimit(std::uint64_t count, std::uint64_t limit, std::string_view opt
 
 void checkDeclaredCounts(std::string_view text, std::string_view format, const std::string& source,
                          const MeshLoadOptions& options) {
-  if (looksLikePly(text)) checkPlyCounts(text, source, options);
+  if (looksLikePly(text)) {
+    checkPlyCounts(text, source, options);
+    checkPlyLists(text, source, options);
+  }
   else if (format == "obj") checkObjCounts(text, source, options);
 }
 

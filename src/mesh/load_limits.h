@@ -1,7 +1,7 @@
 #pragma once
 // The resource limits of mesh loading (MeshLoadOptions::maxVertices, maxTriangles,
 // maxPolygonVertices), checked before the memory they bound is allocated: here on what a file
-// declares (OBJ lines, PLY header), by the OFF reader on its header, and by the loader on the
+// declares (OBJ lines, PLY header and list counts), by the OFF reader on its header, and by the loader on the
 // importer's output before copying it.
 
 #include <cstdint>
@@ -23,7 +23,9 @@ void enforceLimit(std::uint64_t count, std::uint64_t limit, std::string_view opt
 /// vertex once imported, and against maxPolygonVertices per face) and n - 2 triangles each
 /// (one pass, O(size)); the PLY header's `element vertex` and `element face`
 /// counts (each face taken as one triangle), which must also fit in the bytes there are
-/// (kParseError otherwise: each element takes at least a byte). Other content: nothing to check.
+/// (kParseError otherwise: each element takes at least a byte), the header's keywords and types
+/// (kParseError for others), and every list's count in the data, ASCII or binary, against
+/// maxPolygonVertices (the importer sizes a list by it). Other content: nothing to check.
 void checkDeclaredCounts(std::string_view text, std::string_view format, const std::string& source,
                          const MeshLoadOptions& options);
 

@@ -118,6 +118,63 @@ TEST(LoadLimits, PlyHeaderCountsAreCheckedBeforeTheImporterRuns) {
             std::string::npos);
 }
 
+// The importer sizes each PLY list by the count its row gives: a face row declaring a count of 70
+// digits made it ask for 26 GB (found by fuzz_mesh_load). Every list count is held against
+// maxPolygonVertices before it runs, in ASCII and binary files alike.
+std::string plyHeader(std::string_view format, std::string_view countType) {
+  return "ply\nformat " + std::string(format) + " 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+         "property float z\nelement face 1\nproperty list " + std::string(countType) + " int vertex_indices\nend_header\n";
+}
+
+TEST(LoadLimits, PlyListCountsAreCheckedBeforeTheImporterRuns) {
+  const std::string vertices = "0 0 0\n1 0 0\n0 1 0\n";
+  const std::string ascii = plyHeader("ascii", "uchar") + vertices;
+  EXPECT_EQ(loadMeshFromMemory(asBytes(ascii + "3 0 1 2\n"), "ply").mesh.triangleCount(), 1u);
+  EXPECT_NE(limitError([&] { loadMeshFromMemory(asBytes(ascii + std::string(70, '1') + " 0 1 2\n"), "ply"); })
+                .find("entries in one list, more than MeshLoadOptions::maxPolygonVertices"),
+            std::string::npos);
+  EXPECT_NE(limitError([&] { loadMeshFromMemory(asBytes(ascii + "4 0 1 2 0\n"), "ply", limits(100, 100, 3)); })
+                .find("4 entries in one list"),
+            std::string::npos);
+  // Binary, little- and big-endian: a uint count of 4,000,000,000 (and a negative int's bits).
+  for (const std::string format : {"binary_little_endian", "binary_big_endian"}) {
+    std::string binary = plyHeader(format, "uint");
+    for (int v = 0; v < 9; ++v) binary.append(4, '\0');  // 3 vertices of 3 floats (zeros)
+    const std::uint32_t count = 4000000000u;
+    for (int b = 0; b < 4; ++b) {
+      const int shift = format == "binary_little_endian" ? 8 * b : 8 * (3 - b);
+      binary.push_back(static_cast<char>((count >> shift) & 0xffu));
+    }
+    binary.append(12, '\0');
+    EXPECT_NE(limitError([&] { loadMeshFromMemory(asBytes(binary), "ply"); }).find("4000000000 entries in one list"),
+              std::string::npos)
+        << format;
+  }
+}
+
+TEST(LoadLimits, PlyHeadersOutsideTheFormatAreParseErrorsNamingTheLine) {
+  auto parseError = [](const std::string& text) {
+    try {
+      loadMeshFromMemory(asBytes(text), "ply");
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kParseError) << e.what();
+      return std::string(e.what());
+    }
+    ADD_FAILURE() << "no error";
+    return std::string();
+  };
+  const std::string good = plyHeader("ascii", "uchar") + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  std::string keyword = good;
+  keyword.replace(keyword.find("element vertex"), 7, "elemxnt");
+  EXPECT_NE(parseError(keyword).find("line 3: PLY header: unknown keyword 'elemxnt'"), std::string::npos);
+  std::string type = good;
+  type.replace(type.find("float x"), 5, "floau");
+  EXPECT_NE(parseError(type).find("line 4: PLY header: unknown type 'floau'"), std::string::npos);
+  std::string listType = good;
+  listType.replace(listType.find("list uchar"), 10, "list float");
+  EXPECT_NE(parseError(listType).find("an integer count type"), std::string::npos);
+}
+
 TEST(LoadLimits, ImportedScenesAreCheckedWithNodeInstancesCounted) {
   // glTF is not pre-scanned: the check runs on the importer's scene, before clod copies it.
   nlohmann::json gltf = nlohmann::json::parse(readBytes(test::goodFile("box.gltf")));
