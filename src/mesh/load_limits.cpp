@@ -79,44 +79,13 @@ void checkObjCounts(std::string_view text, const std::string& source, const Mesh
   });
 }
 
-// PLY: "element vertex N" and "element face N" in the header (up to end_header, whose presence
-// findPlyHeaderProblem has checked).
-void checkPlyCounts(std::string_view text, const std::string& source, const MeshLoadOptions& options) {
-  forEachLine(text, [&](std::size_t lineNumber, std::string_view line) {
-    const LineShape shape = shapeOf(line);
-    if (shape.keyword == "end_header") return false;
-    if (shape.keyword != "element" || shape.arguments != 2) return true;
-    // The two arguments: the element's name and its count.
-    std::size_t i = line.find("element") + 7;
-    while (i < line.size() && isBlank(line[i])) ++i;
-    std::size_t j = i;
-    while (j < line.size() && !isBlank(line[j])) ++j;
-    const std::string_view name = line.substr(i, j - i);
-    while (j < line.size() && isBlank(line[j])) ++j;
-    std::size_t k = j;
-    while (k < line.size() && !isBlank(line[k]) && line[k] != '#') ++k;
-    std::uint64_t count = 0;
-    const auto [end, ec] = std::from_chars(line.data() + j, line.data() + k, count);
-    if (ec != std::errc() || end != line.data() + k) return true;  // Assimp judges malformed headers
-    const std::string where = lineLabel(source, lineNumber);
-    if (name == "vertex") enforceLimit(count, options.maxVertices, "maxVertices", "vertices declared", where);
-    else if (name == "face") enforceLimit(count, options.maxTriangles, "maxTriangles", "faces declared", where);
-    else return true;
-    // Every vertex (3 coordinates) and face (a list) takes at least one byte in any encoding.
-    if (count > text.size())
-      throw Error(ErrorCode::kParseError, where + ": " + std::to_string(count) + " " + std::string(name) +
-                                              " elements declared, more than a file of " + std::to_string(text.size()) +
-                                              " bytes can hold");
-    return true;
-  });
-}
-
-// PLY's structure, walked before the importer reads the data: the importer sizes each list by the
-// count a row gives (a face row declaring 10^70 corners made it ask for 26 GB), so every list
-// count, ASCII or binary, is held against maxPolygonVertices first. The header must be PLY's own
-// (keywords, scalar types: Turk's format as the importer knows it) -- an unknown keyword or type
-// made the importer read the rows under another layout. Rows past the end of the bytes are the
-// importer's to report.
+// PLY's structure, walked before the importer reads the data. The header (up to end_header, whose
+// presence findPlyHeaderProblem has checked) must be PLY's own -- keywords, scalar types: Turk's
+// format as the importer knows it; an unknown keyword or type made the importer read the rows
+// under another layout -- and its `element vertex N` and `element face N` counts are held against
+// the limits. The importer also sizes each list by the count a row gives (a face row declaring
+// 10^70 corners made it ask for 26 GB), so every list count, ASCII or binary, is held against
+// maxPolygonVertices. Rows past the end of the bytes are the importer's to report.
 struct PlyProperty {
   int countBytes = 0;  // a list's count type (0: a scalar)
   int itemBytes = 0;   // a scalar's type, or a list item's
@@ -151,7 +120,7 @@ std::vector<std::string_view> tokensOf(std::string_view line) {
   return tokens;
 }
 
-void checkPlyLists(std::string_view text, const std::string& source, const MeshLoadOptions& options) {
+void checkPly(std::string_view text, const std::string& source, const MeshLoadOptions& options) {
   std::vector<PlyElement> elements;
   enum class Encoding { kAscii, kLittle, kBig } encoding = Encoding::kAscii;
   std::size_t dataStart = text.size();
@@ -183,6 +152,14 @@ void checkPlyLists(std::string_view text, const std::string& source, const MeshL
       std::uint64_t count = 0;
       if (t.size() != 3 || std::from_chars(t[2].data(), t[2].data() + t[2].size(), count).ptr != t[2].data() + t[2].size())
         bad("'element' needs a name and a count");
+      const std::string where = lineLabel(source, lineNumber);
+      if (t[1] == "vertex") enforceLimit(count, options.maxVertices, "maxVertices", "vertices declared", where);
+      else if (t[1] == "face") enforceLimit(count, options.maxTriangles, "maxTriangles", "faces declared", where);
+      // Every vertex (3 coordinates) and face (a list) takes at least one byte in any encoding.
+      if ((t[1] == "vertex" || t[1] == "face") && count > text.size())
+        throw Error(ErrorCode::kParseError, where + ": " + std::to_string(count) + " " + std::string(t[1]) +
+                                                " elements declared, more than a file of " +
+                                                std::to_string(text.size()) + " bytes can hold");
       elements.push_back({count, {}});
     } else if (keyword == "property") {
       if (elements.empty()) bad("a property before any element");
@@ -294,10 +271,7 @@ void enforceLimit(std::uint64_t count, std::uint64_t limit, std::string_view opt
 
 void checkDeclaredCounts(std::string_view text, std::string_view format, const std::string& source,
                          const MeshLoadOptions& options) {
-  if (looksLikePly(text)) {
-    checkPlyCounts(text, source, options);
-    checkPlyLists(text, source, options);
-  }
+  if (looksLikePly(text)) checkPly(text, source, options);
   else if (format == "obj") checkObjCounts(text, source, options);
 }
 
