@@ -972,6 +972,59 @@ bool supportingEdge(const PatchSide& side, const Vec3& toward, detail::FacePlane
   return cornerCount >= 2;
 }
 
+// The single contact of two faceted patches whose facing features do not overlap in an area (a
+// corner in a face, two crossing edges): where those features touch, on the plane midway between
+// the two sides' supports along the normal. A side's feature is its vertices within a rounding
+// tolerance of its support along n: one vertex (a corner) is the point; two edges (two vertices
+// each) cross at the points of their lines nearest each other across the normal. patchDepthAndPoint
+// places the point from the bounding spheres' centre line, clamped to the sides' common extent: a
+// cube standing on a corner 0.2 off another cube's centre had its contact 0.1 off, under the
+// middle of the line to the corner, so the lever of the one force holding it was half the true
+// one; and the line along the normal through the point of two crossing edges missed one body
+// (issue 18's error-bound promise: 94 % of the box pair's contacts). False (the point is kept)
+// where either feature is larger, or the edges are parallel (facedPatchContacts answers those).
+// Only for sides that are whole convex bodies: a sub-patch's extreme vertex along n may be a
+// vertex of its rim, not where the bodies touch (on two icospheres' leaf patches the promise
+// then held for 32 % of cfm's contacts instead of 58 %).
+bool touchingFeaturesPoint(const PatchSide& sideA, const PatchSide& sideB, const Vec3& n, Vec3& point) {
+  const double maxB = sideB.extent(n).hi;
+  const double minA = sideA.extent(n).lo;
+  auto feature = [&](const PatchSide& side, double support, double sign, std::array<Vec3, 2>& ends) {
+    const double tolerance = 1e-7 * side.body.diagonal();
+    std::size_t count = 0;
+    for (std::uint32_t id : side.body.spherePatchVertices(side.sphere)) {
+      const Vec3 v = side.toA(side.body.mesh().vertices[id]);
+      if (sign * (n.dot(v) - support) < -tolerance) continue;
+      if (count == 2) return std::size_t{3};
+      ends[count++] = v;
+    }
+    return count;
+  };
+  std::array<Vec3, 2> a, b;
+  const std::size_t countB = feature(sideB, maxB, 1.0, b);
+  const std::size_t countA = feature(sideA, minA, -1.0, a);
+  Vec3 q;
+  if (countB == 1) {
+    q = b[0];
+  } else if (countA == 1) {
+    q = a[0];
+  } else if (countA == 2 && countB == 2) {
+    // Across the normal: a(s) - b(t) perpendicular to both edges within the plane of n.
+    auto across = [&](const Vec3& v) { return Vec3(v - n.dot(v) * n); };
+    const Vec3 da = across(a[1] - a[0]), db = across(b[1] - b[0]), r = across(a[0] - b[0]);
+    const double aa = da.dot(da), bb = db.dot(db), ab = da.dot(db);
+    const double det = aa * bb - ab * ab;
+    if (!(det > 1e-12 * aa * bb)) return false;
+    const double sA = std::clamp((ab * db.dot(r) - bb * da.dot(r)) / det, 0.0, 1.0);
+    const double sB = std::clamp((aa * db.dot(r) - ab * da.dot(r)) / det, 0.0, 1.0);
+    q = 0.5 * (a[0] + sA * (a[1] - a[0]) + b[0] + sB * (b[1] - b[0]));
+  } else {
+    return false;
+  }
+  point = q + (0.5 * (maxB + minA) - n.dot(q)) * n;
+  return true;
+}
+
 // Contacts of two faceted patches along the chosen normal c.normal (A frame): where a face of
 // B faces A and a face of A faces B, the corners of the faces' overlap (detail::faceOverlapPoints),
 // each with its own depth (capped, like the single contact's, by the spheres' D&O depth) and
@@ -1322,7 +1375,10 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
       faces.errorBound = 0.0;
       if (convex && facedPatchContacts(sideA, sideB, faces, out)) continue;
       if (grazesAtZeroDepth(sideA, sideB, c)) continue;
-      if (bodyA.patchIsWholeConvexBody(p.a) && bodyB.patchIsWholeConvexBody(p.b)) c.errorBound = 0.0;
+      if (bodyA.patchIsWholeConvexBody(p.a) && bodyB.patchIsWholeConvexBody(p.b)) {
+        c.errorBound = 0.0;
+        touchingFeaturesPoint(sideA, sideB, c.normal, c.point);
+      }
     }
     out.push_back(c);
   }
@@ -1353,7 +1409,9 @@ void convexPolyhedraContacts(const CollisionBody& bodyA, const CollisionBody& bo
   c.featureKind = ContactFeature::kSphere;
   if (leastOverlapNormal(sideA, sideB, rotAFromB, Vec3::Zero(), Vec3::Zero(), c.normal) != PatchAxis::kChosen) return;
   if (!patchDepthAndPoint(sideA, sideB, c.normal, c)) return;
-  if (!facedPatchContacts(sideA, sideB, c, out)) out.push_back(c);
+  if (facedPatchContacts(sideA, sideB, c, out)) return;
+  touchingFeaturesPoint(sideA, sideB, c.normal, c.point);
+  out.push_back(c);
 }
 
 Contact toWorld(const Contact& local, const Pose& xfWorldFromA) {
