@@ -108,6 +108,7 @@ struct Body {
   Aabb localBox;         // mesh bounds, mesh coordinates
   double minExtent = 0;  // smallest side of localBox
   double frameReach = 0; // farthest corner of localBox from the mesh origin (a turn's lever)
+  std::uint32_t maxChildren = 0;  // the most children a sphere of its sphere-tree has
   // State: centre of mass in the world, orientation, velocities.
   Vec3 x = Vec3::Zero();
   Quat q = Quat::Identity();
@@ -187,7 +188,7 @@ struct PairState {
   double apartBy = 0.0;      // the last query proved the surfaces this far apart (QueryResult::separation)
   bool proofFailed = false;  // proveApart could not separate the pair at B's pose `proofFailedAt` in A
   Pose proofFailedAt;
-  std::uint64_t share = 0;   // the even share of the budget the last query had (limited budgets)
+  std::uint64_t share = 0;   // the budget the last query was granted before its frontier's (limited budgets)
   Pose queriedAt;
 };
 
@@ -412,6 +413,7 @@ BodyId World::addBody(const RigidBodyDesc& d) {
   b.localBox = d.shape->mesh().bounds();
   b.minExtent = b.localBox.extent().minCoeff();
   b.frameReach = b.localBox.min.cwiseAbs().cwiseMax(b.localBox.max.cwiseAbs()).norm();
+  for (std::uint32_t n : d.shape->sphereTree().childCount) b.maxChildren = std::max(b.maxChildren, n);
   if (d.type == BodyType::kDynamic) {
     if (!(d.mass > 0.0 && std::isfinite(d.mass))) bad("mass must be > 0 and finite");
     if (!d.inertia.allFinite()) bad("inertia must be finite");
@@ -582,7 +584,18 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     // every substep -- a contact-tree stack at 1,024 tests per frame spent ~1 s of CPU per
     // simulated s doing so -- and the budget it leaves goes to the pairs that can use it, so a
     // resting pair is refined further whenever it is offered more than before.
-    const bool improvable = p->interrupted && (!limited || evenShare > p->share);
+    //
+    // The sphere models (not charged per frontier pair) may take beyond their even share what
+    // re-testing their cached front and one expansion need, where the substep has that left:
+    // below it a query re-derives its last answer. A root pair's expansion costs 1 + 8 tests;
+    // with 16 tests per frame, two pairs and 20 substeps (a 1 cm stack at 60 Hz), the last
+    // substep's even share was 8, and a 1 kg box stayed on its ground pair's one D&O contact
+    // under its centre while a 1,000 kg box on it tipped both through the ground (dos, average).
+    const std::uint64_t progressTests =
+        std::max<std::uint64_t>(1, p->cache.frontSize()) + std::max(a.maxChildren, bb.maxChildren);
+    const std::uint64_t offered =
+        limited && perCell == 0 && progressTests <= remaining ? std::max(evenShare, progressTests) : evenShare;
+    const bool improvable = p->interrupted && (!limited || offered > p->share);
     if ((p->reusable || (p->interrupted && !improvable && !p->contacts.empty() && s.reuseMotionRel > 0.0)) &&
         reuseManifold(*p, a, bb)) {
       pr.reused = true;
@@ -633,7 +646,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
         continue;
       }
       // share >= 1 and share <= remaining, so the substep never spends more than its allowance.
-      std::uint64_t share = evenShare;
+      std::uint64_t share = offered;
       if (perCell > 0) {
         // A cached front is an answer only where it is re-tested: an untested front pair keeps
         // last query's status (query.h), so a moving body sampled through a front it could not
@@ -725,7 +738,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     p->reusable = result.finished && !result.contacts.empty() && s.reuseMotionRel > 0.0;
     p->apartBy = result.separation;
     p->queriedAt = a.pose().inverse() * bb.pose();
-    p->share = evenShare;
+    p->share = offered;
     p->keptFiner = false;
     p->stale = 0;
     p->fresh = true;
