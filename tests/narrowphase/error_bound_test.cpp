@@ -210,6 +210,11 @@ TEST(ErrorBound, DepthWithinItsBoundOfThePenetrationAlongTheNormal) {
   // spot): 100.0 % of 8,387 and 96.2 % of 12,383 over 1,700 poses per pair.
   expectRate("sphere exact unlimited", 0.9);
   expectRate("box/spot exact unlimited", 0.9);
+  // cfm's leaf patches of two icospheres: 75.4 % of 4,020 over 1,700 poses since a piece of a
+  // convex body's surface may no longer take a normal that pushes it through itself (57.5 %
+  // before; 54 % of this 25-pose sample, 72 % after). 65 %: the 1,700-pose rate less a 25-pose
+  // sample's spread.
+  expectRate("sphere cfm unlimited", 0.65);
 }
 
 }  // namespace
