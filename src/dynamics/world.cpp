@@ -450,10 +450,11 @@ void World::Impl::forgetPairsApart() {
       ++it;
       continue;
     }
-    const Body& a = bodies[it->first >> 32];
-    const Body& b = bodies[it->first & 0xffffffffu];
-    const Aabb& ba = boxes[it->first >> 32];
-    const Aabb& bb = boxes[it->first & 0xffffffffu];
+    const std::size_t ia = it->first >> 32, ib = it->first & 0xffffffffu;  // pairKey's halves
+    const Body& a = bodies[ia];
+    const Body& b = bodies[ib];
+    const Aabb& ba = boxes[ia];
+    const Aabb& bb = boxes[ib];
     const double gap = std::max((ba.min - bb.max).maxCoeff(), (bb.min - ba.max).maxCoeff());
     const double near = kPairKeepGapRel * std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal());
     if (gap > 0.0 && gap < near && motionSinceQuery(p, a, b) < near) {

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <charconv>
 #include <limits>
-#include <optional>
 #include <vector>
 
 #include "clod/error.h"
@@ -14,6 +13,15 @@ namespace clod::detail {
 namespace {
 
 bool isBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+
+// The next token of `s` from `at` -- blanks and line ends separate tokens -- with `at` moved past
+// it; empty at the end of `s`.
+std::string_view nextToken(std::string_view s, std::size_t& at) {
+  while (at < s.size() && (isBlank(s[at]) || s[at] == '\n')) ++at;
+  const std::size_t start = at;
+  while (at < s.size() && !isBlank(s[at]) && s[at] != '\n') ++at;
+  return s.substr(start, at - start);
+}
 
 // Calls f(lineNumber, line) for each line (without its '\n').
 template <class F>
@@ -36,16 +44,10 @@ struct LineShape {
 LineShape shapeOf(std::string_view line) {
   if (auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
   LineShape shape;
-  std::size_t i = 0;
-  bool first = true;
-  while (i < line.size()) {
-    while (i < line.size() && isBlank(line[i])) ++i;
-    const std::size_t start = i;
-    while (i < line.size() && !isBlank(line[i])) ++i;
-    if (i == start) break;
-    if (first) shape.keyword = line.substr(start, i - start), first = false;
-    else ++shape.arguments;
-  }
+  std::size_t at = 0;
+  shape.keyword = nextToken(line, at);
+  if (shape.keyword.empty()) return shape;
+  while (!nextToken(line, at).empty()) ++shape.arguments;
   return shape;
 }
 
@@ -110,13 +112,8 @@ int plyTypeBytes(std::string_view type, bool& integer) {
 
 std::vector<std::string_view> tokensOf(std::string_view line) {
   std::vector<std::string_view> tokens;
-  std::size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && isBlank(line[i])) ++i;
-    const std::size_t start = i;
-    while (i < line.size() && !isBlank(line[i])) ++i;
-    if (i > start) tokens.push_back(line.substr(start, i - start));
-  }
+  std::size_t at = 0;
+  for (std::string_view t = nextToken(line, at); !t.empty(); t = nextToken(line, at)) tokens.push_back(t);
   return tokens;
 }
 
@@ -124,24 +121,18 @@ void checkPly(std::string_view text, const std::string& source, const MeshLoadOp
   std::vector<PlyElement> elements;
   enum class Encoding { kAscii, kLittle, kBig } encoding = Encoding::kAscii;
   std::size_t dataStart = text.size();
-  std::size_t lineNumber = 0, pos = 0;
-  auto bad = [&](const std::string& what) {
-    throw Error(ErrorCode::kParseError, lineLabel(source, lineNumber) + ": PLY header: " + what);
-  };
-  while (pos < text.size()) {
-    std::size_t end = text.find('\n', pos);
-    if (end == std::string_view::npos) end = text.size();
-    const std::string_view line = text.substr(pos, end - pos);
-    pos = end + 1;
-    ++lineNumber;
+  forEachLine(text, [&](std::size_t lineNumber, std::string_view line) {
+    auto bad = [&](const std::string& what) {
+      throw Error(ErrorCode::kParseError, lineLabel(source, lineNumber) + ": PLY header: " + what);
+    };
     const std::vector<std::string_view> t = tokensOf(line);
-    if (t.empty()) continue;
+    if (t.empty()) return true;
     const std::string_view keyword = t[0];
     if (keyword == "end_header") {
-      dataStart = std::min(pos, text.size());
-      break;
+      dataStart = std::min(std::size_t(line.data() - text.data()) + line.size() + 1, text.size());
+      return false;
     }
-    if (keyword == "ply" || keyword == "comment" || keyword == "obj_info") continue;
+    if (keyword == "ply" || keyword == "comment" || keyword == "obj_info") return true;
     if (keyword == "format") {
       if (t.size() < 2) bad("'format' without an encoding");
       if (t[1] == "ascii") encoding = Encoding::kAscii;
@@ -183,35 +174,29 @@ void checkPly(std::string_view text, const std::string& source, const MeshLoadOp
         if (c < 0x20 || c > 0x7e) c = '?';
       bad("unknown keyword '" + shown + "'");
     }
-  }
+    return true;
+  });
   const std::string where = source + ": PLY data";
   auto checkCount = [&](std::uint64_t corners) {
     enforceLimit(corners, options.maxPolygonVertices, "maxPolygonVertices", "entries in one list", where);
   };
   if (encoding == Encoding::kAscii) {
     std::size_t at = dataStart;
-    auto nextToken = [&]() -> std::optional<std::string_view> {
-      while (at < text.size() && (isBlank(text[at]) || text[at] == '\n')) ++at;
-      const std::size_t start = at;
-      while (at < text.size() && !isBlank(text[at]) && text[at] != '\n') ++at;
-      if (at == start) return std::nullopt;
-      return text.substr(start, at - start);
-    };
     for (const PlyElement& element : elements)
       for (std::uint64_t row = 0; row < element.count; ++row)
         for (const PlyProperty& property : element.properties) {
-          const std::optional<std::string_view> token = nextToken();
-          if (!token) return;  // truncated: the importer's to report
+          const std::string_view token = nextToken(text, at);
+          if (token.empty()) return;  // truncated: the importer's to report
           if (property.countBytes == 0) continue;
           std::uint64_t count = 0;
-          const auto [end, ec] = std::from_chars(token->data(), token->data() + token->size(), count);
+          const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), count);
           if (ec == std::errc::result_out_of_range) count = std::numeric_limits<std::uint64_t>::max();
-          else if (ec != std::errc() || end != token->data() + token->size())
+          else if (ec != std::errc() || end != token.data() + token.size())
             throw Error(ErrorCode::kParseError, where + ": a list count is not a non-negative integer ('" +
-                                                    std::string(token->substr(0, 32)) + "')");
+                                                    std::string(token.substr(0, 32)) + "')");
           checkCount(count);
           for (std::uint64_t k = 0; k < count; ++k)
-            if (!nextToken()) return;
+            if (nextToken(text, at).empty()) return;
         }
     return;
   }
