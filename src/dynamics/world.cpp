@@ -272,6 +272,7 @@ struct World::Impl {
   std::vector<Aabb> boxes;
   std::vector<std::uint8_t> active;
   std::vector<BodyPair> candidates;
+  std::size_t stepPairs = 0;  // broad-phase pairs of the step's boxes (grown by its travel)
   BroadPhaseScratch bpScratch;
   QueryScratch scratch;
   QueryResult result;
@@ -322,10 +323,14 @@ struct World::Impl {
   }
 
   // limited == false: unlimited budget; else at most `allowance` budget units this substep (0:
-  // none); `nominal` = ceil(budget / substeps), a substep's even share of the step.
+  // none), except that a sphere-model pair may borrow from the rest of the step (`stepLeft`
+  // units, allowance included) the tests one expansion of its front needs; the later substeps'
+  // allowances shrink by as much. `nominal` = ceil(budget / substeps), a substep's even share of
+  // the step; `substepsLeft` of the step's substeps are left, this one included.
   // timeAllowance: narrow-phase seconds this substep may take (WorldSettings::budgetMicros);
   // negative = no time limit.
-  void substep(double h, bool limited, std::uint64_t allowance, std::uint64_t nominal, double timeAllowance);
+  void substep(double h, bool limited, std::uint64_t allowance, std::uint64_t stepLeft, std::uint64_t nominal,
+               std::uint32_t substepsLeft, double timeAllowance);
   void solve(double h);
   // Shock propagation (docs/dynamics.md, "Mass ratios"): support layers of the bodies over this
   // substep's contact graph and the pairs between different layers, bottom-up.
@@ -477,8 +482,8 @@ void World::Impl::checkFinite() const {
   }
 }
 
-void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::uint64_t nominal,
-                          double timeAllowance) {
+void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::uint64_t stepLeft,
+                          std::uint64_t nominal, std::uint32_t substepsLeft, double timeAllowance) {
   const WorldSettings& s = settings;
   using Clock = std::chrono::steady_clock;
   auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
@@ -520,6 +525,14 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
   });
   std::uint64_t remaining = allowance;
   std::size_t left = order.size();
+  // What a pair may borrow from the later substeps: their units, less one test per substep for
+  // each other pair the step may meet (its broad phase ran on boxes grown by the step's travel),
+  // so that no pair goes unqueried for the rest of the step: a light box falling onto a heavy one
+  // was skipped while the heavy one's ground pair borrowed the step, and sank 18 % of its side
+  // into it (16 tests per frame, 1 cm boxes; 46 % with 1 mm boxes at 256 tests).
+  const std::uint64_t laterReserve =
+      std::uint64_t(substepsLeft - 1) * (std::max(order.size(), stepPairs) - std::min<std::size_t>(1, order.size()));
+  std::uint64_t borrowable = stepLeft - std::min(stepLeft, allowance + laterReserve);
   const std::uint64_t cacheShare = std::max<std::uint64_t>(1, s.maxCachedNodePairs / std::max<std::size_t>(1, left));
   // The contact tree samples every cell pair of its answer frontier, cfm looks up both maps and
   // runs a separating-axis test per frontier sphere pair, and exact does the latter for the pairs
@@ -531,6 +544,8 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
   const bool chargedFrontier =
       s.model == ContactModel::kContactTree || s.model == ContactModel::kCfm || s.model == ContactModel::kExact;
   const std::uint64_t perCell = chargedFrontier ? s.frontierPairCost : 0;
+  // dos and average answer one contact per frontier sphere pair: they need expansions.
+  const bool sphereTreeModel = s.model == ContactModel::kDos || s.model == ContactModel::kAverage;
   QuerySettings qs;
   qs.model = s.model;
   qs.maxContacts = s.maxContacts;
@@ -586,16 +601,31 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     // simulated s doing so -- and the budget it leaves goes to the pairs that can use it, so a
     // resting pair is refined further whenever it is offered more than before.
     //
-    // The sphere models (not charged per frontier pair) may take beyond their even share what
-    // re-testing their cached front and one expansion need, where the substep has that left:
-    // below it a query re-derives its last answer. A root pair's expansion costs 1 + 8 tests;
-    // with 16 tests per frame, two pairs and 20 substeps (a 1 cm stack at 60 Hz), the last
-    // substep's even share was 8, and a 1 kg box stayed on its ground pair's one D&O contact
-    // under its centre while a 1,000 kg box on it tipped both through the ground (dos, average).
-    const std::uint64_t progressTests =
-        std::max<std::uint64_t>(1, p->cache.frontSize()) + std::max(a.maxChildren, bb.maxChildren);
-    const std::uint64_t offered =
-        limited && perCell == 0 && progressTests <= remaining ? std::max(evenShare, progressTests) : evenShare;
+    // The sphere models (one contact per frontier sphere pair) may take beyond their even share
+    // what re-testing their cached front and one expansion need, where the step has that left (what
+    // this substep lacks is borrowed from the later ones): below it a query re-derives its last
+    // answer. A root pair's expansion costs 1 + 8 tests; with 16 tests per frame, two pairs and
+    // 20 substeps (a 1 cm stack at 60 Hz), the even shares were at most 8, and a 1 kg box stayed
+    // on its ground pair's one D&O contact under its centre while a 1,000 kg box on it tipped
+    // both through the ground (dos, average). Limited to the substep's own units, a bunny dropped
+    // at 16 tests per frame met the ground in a step of 8 substeps (2 tests each) and turned 140
+    // degrees about its root spheres' one contact; a 1 mm box sliding tipped over.
+    // Short of that, it may take what re-testing its front needs: a query that re-tests part of
+    // its front keeps the rest's statuses, and a box sliding down a slope at 16 tests per frame
+    // passed over ground spheres its cache held apart, lost its leading contacts and tumbled.
+    const std::uint64_t retestTests = std::max<std::uint64_t>(1, p->cache.frontSize());
+    const std::uint64_t progressTests = retestTests + std::max(a.maxChildren, bb.maxChildren);
+    std::uint64_t offered = evenShare;
+    if (limited && sphereTreeModel) {
+      // ... leaving one test to each pair after it in this substep.
+      const std::uint64_t mayUse = remaining + borrowable;
+      const std::uint64_t available = mayUse - std::min<std::uint64_t>(mayUse, left - 1);
+      if (progressTests <= available) {
+        offered = std::max(evenShare, progressTests);
+      } else if (retestTests <= available) {
+        offered = std::max(evenShare, retestTests);
+      }
+    }
     const bool improvable = p->interrupted && (!limited || offered > p->share);
     if ((p->reusable || (p->interrupted && !improvable && !p->contacts.empty() && s.reuseMotionRel > 0.0)) &&
         reuseManifold(*p, a, bb)) {
@@ -642,11 +672,18 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       }
     }
     if (limited) {
+      if (sphereTreeModel && offered > remaining) {
+        // Borrowed: the step's later substeps get as much less (substepAllowance).
+        const std::uint64_t borrowed = std::min(offered - remaining, borrowable);
+        remaining += borrowed;
+        borrowable -= borrowed;
+      }
       if (remaining == 0 && !blind) {
         skip();
         continue;
       }
-      // share >= 1 and share <= remaining, so the substep never spends more than its allowance.
+      // share >= 1 and share <= remaining, so the substep never spends more than its allowance
+      // (and what it borrowed).
       std::uint64_t share = offered;
       if (perCell > 0) {
         // A cached front is an answer only where it is re-tested: an untested front pair keeps
@@ -769,8 +806,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     const double restitution = std::max(a.desc.restitution, b.desc.restitution);
     const double diag = std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal());
     const bool aFixed = a.invMass == 0.0, bFixed = b.invMass == 0.0;
-    const bool sphereModel = s.model == ContactModel::kDos || s.model == ContactModel::kAverage;
-    if (sphereModel && !(aFixed && bFixed) && p->interrupted) {
+    if (sphereTreeModel && !(aFixed && bFixed) && (p->interrupted || s.maxLevel == UINT32_MAX)) {
       // A D&O contact's normal is the centre line of two bounding spheres, an average-model one
       // the mean normal of a sphere's triangles: from the big spheres a query stopped by the budget
       // leaves them at, neither carries a surface. Against an immovable body such a contact is the
@@ -784,10 +820,15 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       // bounding box from the point nearest the other body's centre of mass. The supporting body
       // is the immovable one, else the heavier (what rests on it, or what it holds up); where the
       // other centre lies inside its box (a sunken body, a body inside a concave mesh's box) the
-      // other body's box is asked, and where both say nothing the sphere normal stays. A finished
-      // query (unlimited budget, or a level cap: the experiments that compare normals, e.g.
-      // `clod experiment landing`) keeps its model's normals. Done before persistContacts, so the
-      // anchors and the warm-start matching see the normal the solver uses.
+      // other body's box is asked, and where both say nothing the sphere normal stays. A query
+      // that finished with no level cap (an unlimited budget) is answered this way too: its leaf
+      // spheres still bound the faces, not follow them (dos at 60 Hz: a box sliding on the
+      // ground stopped after 14 % of its distance, tilted 9.6 deg; one sliding down a 35 deg
+      // slope stuck). A level cap (the experiments that compare the models' normals, e.g.
+      // `clod experiment landing`) keeps the model's normals. Done before persistContacts, so the
+      // anchors and the warm-start matching see the normal the solver uses. (The points stay where
+      // D&O puts them: moved onto the support's face, friction there tipped sliding boxes whose
+      // few coarse points do not reach the base's rim, 7-8 deg at 16 tests per frame.)
       const bool aSupports = aFixed || (!bFixed && a.desc.mass >= b.desc.mass);
       const Body& support = aSupports ? a : b;
       const Body& other = aSupports ? b : a;
@@ -1572,6 +1613,7 @@ const StepReport& World::step(double dt) {
   }
   m.findPairsWithinLimit(m.boxes, m.active, m.candidates);
   m.filterCandidates(m.candidates);
+  m.stepPairs = m.candidates.size();
   // Two rules, the larger wins: no body travels more than kTravelFraction of the thinnest
   // extent (no tunnelling), and two bodies that may touch this step travel together at most
   // kArrivalTravelRel of the smaller diagonal (no deep first contact; capped, see above).
@@ -1627,7 +1669,8 @@ const StepReport& World::step(double dt) {
     // The time budget's backstop likewise: an equal share of what the step has left.
     const double timeLeft = std::max(0.0, m.settings.budgetMicros - m.report.timeSpentMicros) * 1e-6;
     const double timeAllowance = timedStep ? timeLeft / static_cast<double>(substepsLeft) : -1.0;
-    m.substep(h, limited, allowance, (budget + n - 1) / n, timeAllowance);
+    const std::uint64_t stepLeft = limited ? budget - std::min(budget, m.report.budgetSpent) : 0;
+    m.substep(h, limited, allowance, stepLeft, (budget + n - 1) / n, n - i, timeAllowance);
     m.checkFinite();
   }
   if (timedStep && m.report.unitsWorked > 0) {
