@@ -324,9 +324,10 @@ struct World::Impl {
 
   // limited == false: unlimited budget; else at most `allowance` budget units this substep (0:
   // none), except that a sphere-model pair may borrow from the rest of the step (`stepLeft`
-  // units, allowance included) the tests one expansion of its front needs; the later substeps'
-  // allowances shrink by as much. `nominal` = ceil(budget / substeps), a substep's even share of
-  // the step; `substepsLeft` of the step's substeps are left, this one included.
+  // units, allowance included) the tests one expansion, or a re-test, of its front needs; the
+  // later substeps' allowances shrink by as much. `nominal` = ceil(budget / substeps), a
+  // substep's even share of the step; `substepsLeft` of the step's substeps are left, this one
+  // included.
   // timeAllowance: narrow-phase seconds this substep may take (WorldSettings::budgetMicros);
   // negative = no time limit.
   void substep(double h, bool limited, std::uint64_t allowance, std::uint64_t stepLeft, std::uint64_t nominal,
@@ -541,11 +542,9 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
   // from the roots) and T tests: a retest keeps or drops a cached pair, and an expansion replaces
   // one pair by at most as many children as it made tests (an interrupted expansion keeps the
   // pair whole). So T is chosen with T + perCell * max(F, T) <= what the pair may spend.
-  const bool chargedFrontier =
-      s.model == ContactModel::kContactTree || s.model == ContactModel::kCfm || s.model == ContactModel::kExact;
-  const std::uint64_t perCell = chargedFrontier ? s.frontierPairCost : 0;
-  // dos and average answer one contact per frontier sphere pair: they need expansions.
+  // dos and average answer one contact per frontier sphere pair (not charged; they need expansions).
   const bool sphereTreeModel = s.model == ContactModel::kDos || s.model == ContactModel::kAverage;
+  const std::uint64_t perCell = sphereTreeModel ? 0 : s.frontierPairCost;
   QuerySettings qs;
   qs.model = s.model;
   qs.maxContacts = s.maxContacts;

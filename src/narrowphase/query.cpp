@@ -793,11 +793,11 @@ PatchAxis leastOverlapNormal(const PatchSide& sideA, const PatchSide& sideB, con
                                       sideB.body.patchIsWholeConvexBody(sideB.sphere));
   auto facesTheOtherPiece = [&](const Vec3& n) {
     if (!piecesOfConvexBodies) return true;
-    bool fromA = false, fromB = false;
-    for (const Vec3f& f : sideA.body.sphereFaceNormals(sideA.sphere)) fromA = fromA || f.cast<double>().dot(n) < 0.0;
-    for (const Vec3f& f : sideB.body.sphereFaceNormals(sideB.sphere))
-      fromB = fromB || (rotAFromB * f.cast<double>()).dot(n) > 0.0;
-    return fromA && fromB;
+    const auto facesA = sideA.body.sphereFaceNormals(sideA.sphere);
+    const auto facesB = sideB.body.sphereFaceNormals(sideB.sphere);
+    return std::any_of(facesA.begin(), facesA.end(), [&](const Vec3f& f) { return f.cast<double>().dot(n) < 0.0; }) &&
+           std::any_of(facesB.begin(), facesB.end(),
+                       [&](const Vec3f& f) { return (rotAFromB * f.cast<double>()).dot(n) > 0.0; });
   };
   double fallbackOverlap = std::numeric_limits<double>::infinity();
   Vec3 fallback = Vec3::Zero();
