@@ -11,8 +11,9 @@ usage: scripts/probe-random-scenes.py SEED KINDS OUTDIR
   the judge's thresholds are scaled the same way; issue 21's 1 mm .. 100 m).
 Prints one FAIL line per run that breaks a criterion of issue 17's point 1 (drops: the lowest
 vertex more than 1 % of the diagonal below the floor top at any frame, or still moving after
-5 s), NONMONO lines where the run's error grew with the budget, the deepest sink of the drops,
-and a count. Each run's scene,
+5 s; every scene: a dynamic body's centre inside a static box or under it within its footprint
+at any frame, "through"), NONMONO lines where the run's error grew with the budget, the deepest
+sink of the drops, and a count. Each run's scene,
 trajectory and summary stay in OUTDIR.
 """
 import json, math, os, random, subprocess, sys, csv, concurrent.futures as cf
@@ -147,7 +148,7 @@ def load_obj(path):
         if line.startswith('v '): V.append([float(x) for x in line.split()[1:4]])
     return V
 
-def judge(traj, info, dt):
+def judge(traj, info, dt, scene=None):
     rows = list(csv.DictReader(open(traj)))
     names = sorted({r['body'] for r in rows if r['body']!='ground'})
     last = {}; first = {}
@@ -164,6 +165,20 @@ def judge(traj, info, dt):
     for b in names:
         for v in P(last[b])+V(last[b]):
             if not math.isfinite(v): return ['NaN'], float('nan')
+    # Never through a static body (issue 17): a dynamic body's centre of mass inside a static box,
+    # or under it within its footprint (fallen through a ground slab or a slope), at any frame. (The
+    # probe's static bodies are grounds and slopes, which nothing rests under.)
+    through = set()
+    dynamic = {x.get('name') for x in (scene or {}).get('bodies', []) if not x.get('static')}
+    for sb in (scene or {}).get('bodies', []):
+        if not sb.get('static') or 'box' not in sb: continue
+        c = sb.get('position', [0, 0, 0]); hb = sb['box']; qs = sb.get('orientation', [1, 0, 0, 0])
+        qi = [qs[0], -qs[1], -qs[2], -qs[3]]
+        for r in rows:
+            if r['body'] in through or r['body'] not in dynamic: continue
+            loc = rot(qi, [P(r)[i] - c[i] for i in range(3)])
+            if abs(loc[0]) < hb[0] and abs(loc[1]) < hb[1] and loc[2] < hb[2]:
+                through.add(r['body']); fails.append(f"{r['body']} through {sb.get('name')} at t={float(r['time']):.2f}s")
     if info['kind']=='stack':
         # top = highest initial
         top = max(names, key=lambda b: P(first[b])[2])
@@ -206,7 +221,7 @@ def run_one(args):
     f = os.path.join(d,'scene.json'); json.dump(sc, open(f,'w'))
     r = subprocess.run(['nice', CLOD,'simulate',f,'-o',os.path.join(d,'out')],capture_output=True,text=True,timeout=600)
     if r.returncode!=0: return (sid,model,budget,bus,rate,['exit %d: %s'%(r.returncode,r.stderr.strip()[-200:])],float('nan'))
-    fails, err = judge(os.path.join(d,'out','trajectory.csv'), info, 1.0/rate)
+    fails, err = judge(os.path.join(d,'out','trajectory.csv'), info, 1.0/rate, sc)
     return (sid,model,budget,bus,rate,fails,err)
 
 if __name__=='__main__':

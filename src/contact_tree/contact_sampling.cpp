@@ -202,6 +202,11 @@ constexpr int kSlideSteps = 4;
 // farthest toward the other body (cell_support.h).
 constexpr double kSupportBandRel = 0.05;
 constexpr int kDescentSteps = 4;  // after entering: on down to the deepest point
+// A finished answer's inner cell pair samples its lattice only where a support point of S within
+// kGateReachRel of O's cell size of O's cell lies within kGateNearRel of S's cell size of O
+// (sampleUnchecked).
+constexpr double kGateReachRel = 0.25;
+constexpr double kGateNearRel = 0.5;
 constexpr double kDescentGainRel = 0.01;  // a descent step must gain this fraction of eps_O
 
 struct SlideFrame {
@@ -463,6 +468,28 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
     // nearly flat face resting on the floor (a random fandisk drop rested 0.98 % of its
     // diagonal deep at 64 tests with support points alone, 0.61 % with the lattice beside them).
     if (!settings.supportPoints) return;
+  }
+  // A finished answer's inner cell pair (the traversal stops at resolved cells, not at leaves)
+  // samples its lattice only where S's surface may come near O: where a support point of S's
+  // cell within a quarter of O's cell of it lies within half of S's cell of O, counting its
+  // distance to O's cell on top of O's field there (1-Lipschitz). Elsewhere every lattice point
+  // would have cost up to five field queries -- four to move it onto S's surface, one for O --
+  // for nothing: most resolved pairs of two deep bodies hold no contact (bunny-1500's deep pair:
+  // 824 pairs with a plane on both sides, 263 contacts). A heuristic, not a proof (S's surface
+  // can cross O's cell between its support points); measured on 2 x 1,000 touching poses
+  // (bench_narrowphase --accuracy=1000 --accuracy-models=contact-tree --accuracy-meshes=bunny,fandisk)
+  // every accuracy figure and the poses without a contact are unchanged, and the unlimited query
+  // takes 4.58 -> 1.62 ms (bunny-1500) and 3.09 -> 1.82 ms (fandisk). Interrupted answers sample
+  // support points and lattice alike (above and below).
+  if (!settings.supportPoints && !supports.empty() && !treeS.isLeaf(cellS.node)) {
+    const Vec3 lowO = treeO.cellMin(cellO), highO = lowO + Vec3::Constant(hO);
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Vec3& p : supports) {
+      const Vec3 pO = xfOFromS.apply(p);
+      const double away = (lowO - pO).cwiseMax(pO - highO).cwiseMax(0.0).norm();
+      if (away <= kGateReachRel * hO) nearest = std::min(nearest, treeO.sample(pO, settings.maxDepth).distance + away);
+    }
+    if (nearest > kGateNearRel * h) return;
   }
   for (int i = iFirst; i <= i0 + reach; ++i) {
     for (int j = jFirst; j <= j0 + reach; ++j) {
