@@ -43,6 +43,7 @@
 #include <span>
 #include <vector>
 
+#include "clod/bit_count.h"
 #include "clod/math.h"
 
 namespace clod {
@@ -212,14 +213,14 @@ struct ContactTree {
     const ContactTreeNodeWord& w = nodeWords[node >> 6];
     const std::uint64_t upTo = w.interior & (~std::uint64_t{0} >> (63 - (node & 63)));
     if (((w.interior >> (node & 63)) & 1u) == 0) return 0;
-    return 1 + 8 * (w.interiorBefore + static_cast<std::uint32_t>(std::popcount(upTo)) - 1);
+    return 1 + 8 * (w.interiorBefore + detail::popcount64(upTo) - 1);
   }
   /// Index into halfSpaces of a surface cell's half-space, or kNoHalfSpace. O(1).
   std::uint32_t halfSpaceIndex(std::uint32_t node) const {
     const ContactTreeNodeWord& w = nodeWords[node >> 6];
     if (((w.surface >> (node & 63)) & 1u) == 0) return kNoHalfSpace;
     const std::uint64_t below = w.surface & ((std::uint64_t{1} << (node & 63)) - 1);
-    return w.surfaceBefore + static_cast<std::uint32_t>(std::popcount(below));
+    return w.surfaceBefore + detail::popcount64(below);
   }
   /// Interpolation error bound of the node's cell, in mesh units: the largest |trilinear -
   /// exact| measured at the cell's test points times the gap factor (docs/contact-tree.md:

@@ -269,7 +269,7 @@ ContactFieldSample ContactTree::sample(const Vec3& p, std::uint32_t maxDepthQuer
     if (((w.interior >> b) & 1u) == 0) break;
     // Rank of this interior node = interior nodes before it; its children start at 1 + 8 rank.
     const std::uint64_t below = w.interior & ((std::uint64_t{1} << b) - 1);
-    const std::uint32_t rank = w.interiorBefore + static_cast<std::uint32_t>(std::popcount(below));
+    const std::uint32_t rank = w.interiorBefore + detail::popcount64(below);
     const float* block = pool + std::size_t{rank} * kContactTreeLatticePerNode;
     __builtin_prefetch(block);
     __builtin_prefetch(block + kContactTreeLatticePerNode - 1);

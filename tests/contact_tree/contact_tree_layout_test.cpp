@@ -10,6 +10,7 @@
 #include <random>
 #include <vector>
 
+#include "clod/bit_count.h"
 #include "clod/contact_tree.h"
 #include "clod/contact_tree_builder.h"
 #include "clod/primitives.h"
@@ -17,6 +18,21 @@
 
 namespace clod {
 namespace {
+
+// The rank queries' population count against counting the bits one by one.
+TEST(ContactTreeRank, PopcountCountsEveryBit) {
+  auto oneByOne = [](std::uint64_t x) {
+    std::uint32_t n = 0;
+    for (int b = 0; b < 64; ++b) n += (x >> b) & 1u;
+    return n;
+  };
+  std::vector<std::uint64_t> words = {0, ~std::uint64_t{0}, 1, std::uint64_t{1} << 63, 0x5555555555555555ull,
+                                      0xaaaaaaaaaaaaaaaaull, 0x8000000000000001ull};
+  std::mt19937_64 rng(5);
+  for (int i = 0; i < 10000; ++i) words.push_back(rng() & rng());  // sparser words too
+  for (int i = 0; i < 10000; ++i) words.push_back(rng());
+  for (std::uint64_t w : words) ASSERT_EQ(detail::popcount64(w), oneByOne(w)) << std::hex << w;
+}
 
 TEST(ContactTreeErrorCode, DecodedBoundIsNeverBelowTheRatioAndAtMostOnePartIn128Above) {
   std::mt19937_64 rng(11);
