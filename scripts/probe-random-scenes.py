@@ -168,9 +168,10 @@ def judge(traj, info, dt, scene=None):
     # Never through a static body (issue 17): a dynamic body's centre of mass inside a static box,
     # or under it within its footprint (fallen through a ground slab or a slope), at any frame. (The
     # probe's static bodies are grounds and slopes, which nothing rests under.)
+    bodies = (scene or {}).get('bodies', [])
+    dynamic = {x.get('name') for x in bodies if not x.get('static')}
     through = set()
-    dynamic = {x.get('name') for x in (scene or {}).get('bodies', []) if not x.get('static')}
-    for sb in (scene or {}).get('bodies', []):
+    for sb in bodies:
         if not sb.get('static') or 'box' not in sb: continue
         c = sb.get('position', [0, 0, 0]); hb = sb['box']; qs = sb.get('orientation', [1, 0, 0, 0])
         qi = [qs[0], -qs[1], -qs[2], -qs[3]]
