@@ -171,13 +171,19 @@ def judge(traj, info, dt, scene=None):
     bodies = (scene or {}).get('bodies', [])
     dynamic = {x.get('name') for x in bodies if not x.get('static')}
     through = set()
+    # A dropped mesh's frame origin can lie far from its geometry (the fandisk's is below its
+    # bounding box): its vertices' centroid stands for it. Boxes are centred on their origin.
+    centroid = [sum(v[i] for v in info['verts']) / len(info['verts']) for i in range(3)] if info.get('verts') else None
+    def centre(r):
+        if centroid is None: return P(r)
+        return [P(r)[i] + rot(Q(r), centroid)[i] for i in range(3)]
     for sb in bodies:
         if not sb.get('static') or 'box' not in sb: continue
         c = sb.get('position', [0, 0, 0]); hb = sb['box']; qs = sb.get('orientation', [1, 0, 0, 0])
         qi = [qs[0], -qs[1], -qs[2], -qs[3]]
         for r in rows:
             if r['body'] in through or r['body'] not in dynamic: continue
-            loc = rot(qi, [P(r)[i] - c[i] for i in range(3)])
+            loc = rot(qi, [centre(r)[i] - c[i] for i in range(3)])
             if abs(loc[0]) < hb[0] and abs(loc[1]) < hb[1] and loc[2] < hb[2]:
                 through.add(r['body']); fails.append(f"{r['body']} through {sb.get('name')} at t={float(r['time']):.2f}s")
     if info['kind']=='stack':
