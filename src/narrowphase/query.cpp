@@ -906,6 +906,12 @@ PatchAxis leastOverlapNormal(const PatchSide& sideA, const PatchSide& sideB, con
     keep(alongN, n);
     keep(againstN, -n);
   };
+  // The best axis, or the best of those that push a convex piece through itself if no other
+  // was found.
+  auto chosen = [&] {
+    if (bestOverlap == std::numeric_limits<double>::infinity() && fallbackOverlap < bestOverlap) best = fallback;
+    return PatchAxis::kChosen;
+  };
   if (sideA.faceted && sideB.faceted) {
     // Both sides are vertex sets: the candidate axes are gathered, then projected in one pass
     // (SatAxes) and judged in the order above. The face axes first: a pair they prove apart
@@ -931,10 +937,7 @@ PatchAxis leastOverlapNormal(const PatchSide& sideA, const PatchSide& sideB, con
     // time, are left to the few that may matter.
     axes.count = 0;
     axes.gatherEdgeCrossProducts(sideA, sideB, rotAFromB);
-    if (axes.count == 0) {
-      if (bestOverlap == std::numeric_limits<double>::infinity() && fallbackOverlap < bestOverlap) best = fallback;
-      return PatchAxis::kChosen;
-    }
+    if (axes.count == 0) return chosen();
     axes.project(vertsA, axes.loA, axes.hiA);
     axes.project(vertsB, axes.loB, axes.hiB);
     constexpr double kRoundingRel = 1e-12;
@@ -955,8 +958,7 @@ PatchAxis leastOverlapNormal(const PatchSide& sideA, const PatchSide& sideB, con
       keep(alongN, n);
       keep(againstN, -n);
     }
-    if (bestOverlap == std::numeric_limits<double>::infinity() && fallbackOverlap < bestOverlap) best = fallback;
-    return PatchAxis::kChosen;
+    return chosen();
   }
   if (sideB.faceted) {
     for (const Vec3f& f : sideB.body.sphereFaceNormals(sideB.sphere)) consider(rotAFromB * f.cast<double>());
@@ -966,9 +968,7 @@ PatchAxis leastOverlapNormal(const PatchSide& sideA, const PatchSide& sideB, con
   }
   consider(nB);  // one side curved: the maps' normals
   consider(nA);
-  if (apart) return PatchAxis::kApart;
-  if (bestOverlap == std::numeric_limits<double>::infinity() && fallbackOverlap < bestOverlap) best = fallback;
-  return PatchAxis::kChosen;
+  return apart ? PatchAxis::kApart : chosen();
 }
 
 // The vertex among `ids` of a side's mesh that reaches farthest along `dir` (A frame), in A's frame.
