@@ -252,6 +252,13 @@ using CellPair = NodePair<ContactCell, ContactCell>;
 
 // ---------------------------------------------------------------------------------------------
 
+// A convex body's corner tested against a closed non-convex body in one answer
+// (cornersInsideContacts), and whether it was inside.
+struct ProbedCorner {
+  std::uint32_t vertex;
+  bool inside;
+};
+
 struct QueryScratch::Impl {
   std::vector<SpherePair> sphereFront, sphereNext, sphereSeparated;
   std::vector<CellPair> cellFront, cellNext, cellSeparated;
@@ -315,6 +322,11 @@ struct QueryScratch::Impl {
   std::array<std::vector<std::uint32_t>, 2> triedVertices;
   std::vector<Contact> vertexContacts;
   std::vector<std::uint8_t> patchHasVertices;
+  // Corners of a convex body's patches already probed against a closed non-convex body's exact
+  // field in this answer (cornersInsideContacts), per side (A, B).
+  std::array<std::vector<ProbedCorner>, 2> probedCorners;
+  // Separating-axis contacts of such pairs without a vertex inside, kept only if no pair has one.
+  std::vector<Contact> edgeContacts;
   std::vector<std::uint32_t> clippers;
   std::vector<Vec3> poly, polyTmp;
   std::vector<Contact> raw;
@@ -1379,6 +1391,63 @@ bool cornersOverFlatPatchContacts(const PatchSide& flat, const PatchSide& convex
   return out.size() > before;
 }
 
+// Corners of a convex body's faceted patch that lie inside a closed non-convex body, by that body's
+// exact signed distance (detail::exactBodyField: nearest triangle, signed by the angle-weighted
+// pseudonormal). Each is a contact at its own depth, along the field's gradient (out through the
+// nearest surface), error bound 0. Between a convex patch and a non-convex one the separating-axis
+// choice treats the non-convex side as its convex hull, and a box standing in the hull's pocket
+// (on the floor of an L-shaped body, beside its wall) overlaps that hull least downward, through
+// the floor: its contact pushed the box into the floor, 0.999 deep, and at 16-64 tests per frame
+// it fell through (cfm and exact alike). Each corner is probed once per answer (`probed`: the
+// convex side's corners tested so far, with the answer), by the pairs whose non-convex sphere
+// holds it; its contact is added once. Returns whether a corner in this pair's sphere is inside.
+bool cornersInsideContacts(const PatchSide& nonConvex, const PatchSide& convex, bool convexIsB, const Contact& c,
+                           detail::ContainmentScratch& scratch, std::vector<ProbedCorner>& probed,
+                           std::vector<Contact>& out) {
+  const TriangleMesh& mesh = convex.body.mesh();
+  const double tolerance = 1e-9 * (nonConvex.body.diagonal() + convex.body.diagonal());
+  bool anyInside = false;
+  for (std::uint32_t id : convex.body.spherePatchVertices(convex.sphere)) {
+    const Vec3 v = convex.toA(mesh.vertices[id]);
+    if ((v - nonConvex.centre).squaredNorm() > nonConvex.radius * nonConvex.radius) continue;
+    const auto seen = std::find_if(probed.begin(), probed.end(), [id](const ProbedCorner& p) { return p.vertex == id; });
+    if (seen != probed.end()) {
+      anyInside = anyInside || seen->inside;
+      continue;
+    }
+    const Vec3 local = nonConvex.rotToA ? Vec3(nonConvex.rotToA->transpose() * (v - nonConvex.shift)) : v;
+    const detail::FieldValue f = detail::exactBodyField(nonConvex.body, local, scratch);
+    const bool inside = f.distance < -tolerance;
+    probed.push_back({id, inside});
+    if (!inside) continue;
+    anyInside = true;
+    const Vec3 exit = nonConvex.rotToA ? Vec3(*nonConvex.rotToA * f.gradient) : f.gradient;  // A frame
+    Contact ci = c;
+    ci.depth = -f.distance;
+    ci.normal = convexIsB ? Vec3(-exit) : exit;  // the convex body leaves along exit
+    ci.point = v + 0.5 * ci.depth * exit;
+    ci.errorBound = 0.0;
+    out.push_back(ci);
+  }
+  return anyInside;
+}
+
+// Whether a faceted patch is convex: every one of its vertices on or behind the plane of every one
+// of its triangles. A piece of a non-convex body can be (a step's edge), and then its hull is its
+// body there; one that holds a concave corner (an L-shaped body's floor and wall) is not.
+bool facetedPatchIsConvex(const CollisionBody& body, std::uint32_t sphere) {
+  const TriangleMesh& mesh = body.mesh();
+  const double tolerance = 1e-9 * body.diagonal();
+  const std::span<const std::uint32_t> vertices = body.spherePatchVertices(sphere);
+  for (std::uint32_t t : body.sphereTree().triangles(sphere)) {
+    const Vec3 n = mesh.triangleNormal(t);
+    const double offset = n.dot(mesh.corner(t, 0));
+    for (std::uint32_t v : vertices)
+      if (n.dot(mesh.vertices[v]) > offset + tolerance) return false;
+  }
+  return true;
+}
+
 // Two faceted patches whose least-overlap axis shows zero depth, and that have no faces facing
 // each other along it, only graze: coplanar side faces lying flush (a box resting on an equal
 // box, shifted along one axis), or a side face standing on the rim of a top face. Such a contact
@@ -1399,12 +1468,17 @@ Vec3 differenceNormal(const Vec3& nA, const Vec3& nB, const Vec3& dosNormal) {
 // Contacts of the sphere models, one per frontier pair. Pairs proven apart (cfm: a separating
 // axis between their patches) give none.
 void sphereContacts(ContactModel model, const CollisionBody& bodyA, const CollisionBody& bodyB, const Pose& xfAFromB,
-                    const std::vector<SpherePair>& front, AnswerClock& clock, std::vector<Contact>& out) {
+                    const std::vector<SpherePair>& front, AnswerClock& clock, QueryScratch::Impl& s,
+                    std::vector<Contact>& out) {
+  s.probedCorners[0].clear();
+  s.probedCorners[1].clear();
+  s.edgeContacts.clear();
+  bool vertexInside = false;  // a vertex of a closed non-convex body or of a convex patch inside the other
   const SphereTree& ta = bodyA.sphereTree();
   const SphereTree& tb = bodyB.sphereTree();
   const Eigen::Matrix3d rotAFromB = xfAFromB.rotation.toRotationMatrix();
   for (const SpherePair& p : front) {
-    if (!clock.next(!out.empty())) break;
+    if (!clock.next(!out.empty() || !s.edgeContacts.empty())) break;
     const Vec3 cA = ta.center(p.a);
     const Vec3 cB = xfAFromB.apply(tb.center(p.b));
     const double rA = ta.radius[p.a];
@@ -1491,26 +1565,59 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
     // single patch contact held the Figure 6 bunny 95 deg from the exact run's pose; with their
     // vertices, 13 deg (`clod experiment landing`).
     const bool convexA = bodyA.isConvexPolyhedron(), convexB = bodyB.isConvexPolyhedron();
-    // A flat patch of a non-convex body against a convex patch: the convex corners over it and its
-    // own vertices inside the convex body are the whole contact; none of either means the convex
-    // body's underside does not reach into this piece (an edge lying across it is held by the
-    // corners over the neighbouring pieces).
-    const bool flatA = !convexA && sideB.faceted && convexB && bodyA.sphereFaceNormals(p.a).size() == 1;
-    const bool flatB = !flatA && !convexB && sideA.faceted && convexA && bodyB.sphereFaceNormals(p.b).size() == 1;
-    if (flatA) {
-      cornersOverFlatPatchContacts(sideA, sideB, false, c, out);
-      vertexOnFaceContacts(sideA, sideB, c.normal, c, out);
+    // A closed non-convex body against a convex body's faceted patch: the convex corners inside the
+    // body and the body's vertices inside the convex one, each at its exact depth, are the contact.
+    const bool closedA = !convexA && bodyA.isClosed() && sideB.faceted && convexB;
+    const bool closedB = !closedA && !convexB && bodyB.isClosed() && sideA.faceted && convexA;
+    if (closedA || closedB) {
+      const PatchSide& body = closedA ? sideA : sideB;
+      const PatchSide& convex = closedA ? sideB : sideA;
+      bool any = cornersInsideContacts(body, convex, closedA, c, s.containment, s.probedCorners[closedA ? 1 : 0], out);
+      any = vertexOnFaceContacts(body, convex, closedA ? c.normal : Vec3(-c.normal), c, out) || any;
+      if (any) {
+        vertexInside = true;
+        continue;
+      }
+      // Neither body has a vertex in the other here: they are apart, or edges cross, which the
+      // separating-axis contact stands for only where the body's side is its hull there: not on a
+      // flat piece (the convex body's underside does not reach into it; an edge lying across it
+      // is held by the corners over the neighbouring pieces), nor on a faceted piece that is not
+      // convex, nor where the overlap along the axis exceeds the convex patch's own extent along
+      // it (the patch lies wholly inside the other side's hull: in its pocket). And only where no
+      // vertex of either lies inside the other anywhere (edges crossing alone): otherwise the
+      // vertex contacts are the bodies' deepest points, and a separating-axis contact stands at
+      // its pair's D&O point, up to a sphere away from where the bodies meet (a box balanced on
+      // one corner on a bin's floor got three such contacts around it at an unlimited budget and
+      // stood on them).
+      if (body.body.sphereFaceNormals(body.sphere).size() == 1 || (body.faceted && !facetedPatchIsConvex(body.body, body.sphere)))
+        continue;
+      const Extent e = convex.vertexExtent(c.normal);
+      if (c.depth > e.hi - e.lo) continue;
+      if (sideA.faceted && sideB.faceted && grazesAtZeroDepth(sideA, sideB, c)) continue;
+      s.edgeContacts.push_back(c);
       continue;
+    } else {
+      // A flat patch of an open non-convex body (a ground quad) against a convex patch: the convex
+      // corners over it and its own vertices inside the convex body are the whole contact; none of
+      // either means the convex body's underside does not reach into this piece (an edge lying
+      // across it is held by the corners over the neighbouring pieces).
+      const bool flatA = !convexA && sideB.faceted && convexB && bodyA.sphereFaceNormals(p.a).size() == 1;
+      const bool flatB = !flatA && !convexB && sideA.faceted && convexA && bodyB.sphereFaceNormals(p.b).size() == 1;
+      if (flatA) {
+        cornersOverFlatPatchContacts(sideA, sideB, false, c, out);
+        vertexOnFaceContacts(sideA, sideB, c.normal, c, out);
+        continue;
+      }
+      if (flatB) {
+        cornersOverFlatPatchContacts(sideB, sideA, true, c, out);
+        vertexOnFaceContacts(sideB, sideA, -c.normal, c, out);
+        continue;
+      }
+      if ((!sideA.faceted || !convexA) && sideB.faceted && convexB && vertexOnFaceContacts(sideA, sideB, c.normal, c, out))
+        continue;
+      if ((!sideB.faceted || !convexB) && sideA.faceted && convexA && vertexOnFaceContacts(sideB, sideA, -c.normal, c, out))
+        continue;
     }
-    if (flatB) {
-      cornersOverFlatPatchContacts(sideB, sideA, true, c, out);
-      vertexOnFaceContacts(sideB, sideA, -c.normal, c, out);
-      continue;
-    }
-    if ((!sideA.faceted || !convexA) && sideB.faceted && convexB && vertexOnFaceContacts(sideA, sideB, c.normal, c, out))
-      continue;
-    if ((!sideB.faceted || !convexB) && sideA.faceted && convexA && vertexOnFaceContacts(sideB, sideA, -c.normal, c, out))
-      continue;
     if (sideA.faceted && sideB.faceted) {
       // Face-on-face corners between two convex polyhedra are exact (their faces are the bodies'
       // faces); so is everything when both patches are the whole bodies (the separating-axis
@@ -1530,6 +1637,7 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
     }
     out.push_back(c);
   }
+  if (!vertexInside) out.insert(out.end(), s.edgeContacts.begin(), s.edgeContacts.end());
 }
 
 // The exact model between two closed convex polyhedra whose root patches are the whole bodies
@@ -2340,7 +2448,7 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
         const ContactModel fallback =
             a.hasClosestFeatureMap() && b.hasClosestFeatureMap() ? ContactModel::kCfm : ContactModel::kDos;
         AnswerClock answer(settings.budget, kAnswerBatch);
-        sphereContacts(fallback, a, b, xfAFromB, s.sphereNext, answer, s.raw);
+        sphereContacts(fallback, a, b, xfAFromB, s.sphereNext, answer, s, s.raw);
         learnAnswerCost(answer, answerCost);
         result.fallbackPairs = s.sphereNext.size();
         result.fallbackModel = fallback;
@@ -2354,7 +2462,7 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
       }
     } else {
       AnswerClock answer(settings.budget, kAnswerBatch);
-      sphereContacts(model, a, b, xfAFromB, s.sphereFront, answer, s.raw);
+      sphereContacts(model, a, b, xfAFromB, s.sphereFront, answer, s, s.raw);
       learnAnswerCost(answer, answerCost);
       result.pairsAnswered = answer.answered();
       // cfm drops pairs proven apart: colliding means some pair gave a contact.

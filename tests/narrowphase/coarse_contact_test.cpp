@@ -19,6 +19,7 @@
 #include "clod/mesh_io.h"
 #include "clod/primitives.h"
 #include "support/grid_box.h"
+#include "support/l_shaped_body.h"
 #include "support/test_scale.h"
 #include "clod/proximity.h"
 #include "clod/query.h"
@@ -605,6 +606,50 @@ TEST(CoarseContacts, CubeOnOneEdgeOverAFlatPieceOfANonConvexFloorRestsOnItsTwoLo
       }
     }
     EXPECT_TRUE(found[0] && found[1]) << what;
+  }
+}
+
+// A 0.5 m box standing 1 mm deep on the floor of a closed L-shaped body (test::makeLShapedBody), once in the open and once in the
+// corner with its +x face flush with the wall. Oracle, by construction: the contact is the four
+// bottom corners, 1 mm below the plane z = 0, pushed straight up. The separating-axis choice
+// treated the L's patches as their convex hull, in whose pocket the box stands: the least overlap
+// was downward, through the floor (0.999 deep; the box fell through at 16 and 64 tests per frame,
+// cfm and exact alike). cfm at 1-256 tests, and exact where it answers from the spheres (1-16
+// tests: its traversal does not finish, so every pair falls back to cfm; at 64 it finishes and
+// tests some triangle pairs, whose partial patches are not this test's subject); both orders of
+// the bodies.
+TEST(CoarseContacts, BoxOnTheFloorOfAnLShapedBodyIsHeldUpByItsCornersAtEveryBudget) {
+  static const CollisionBody ground = octreeBodyForCfm(test::makeLShapedBody());
+  static const CollisionBody box = octreeBodyForCfm(makeBox(Vec3::Constant(0.25)));
+  ASSERT_TRUE(ground.isClosed());
+  ASSERT_FALSE(ground.isConvexPolyhedron());
+  constexpr double kSunk = 0.001;
+  const double rounding = 1e-9 * (ground.diagonal() + box.diagonal());  // float-free: exact corners
+  for (const double x : {-1.0, 0.75}) {
+    const Pose pose{Quat::Identity(), Vec3(x, 0.3, 0.25 - kSunk)};
+    for (const ContactModel model : {ContactModel::kCfm, ContactModel::kExact}) {
+      for (const std::uint64_t budget : {std::uint64_t(1), std::uint64_t(4), std::uint64_t(16), std::uint64_t(64), std::uint64_t(256)}) {
+        if (model == ContactModel::kExact && budget > 16) continue;
+        for (const bool groundIsA : {true, false}) {
+          const QuerySettings settings = settingsFor(model, budget);
+          const QueryResult r = groundIsA ? queryContacts(ground, Pose{}, box, pose, settings)
+                                          : queryContacts(box, pose, ground, Pose{}, settings);
+          const std::string what = std::string(contactModelName(model)) + " at " + std::to_string(budget) +
+                                   " tests, box at x = " + std::to_string(x) + (groundIsA ? ", ground is A" : ", ground is B");
+          bool found[4] = {false, false, false, false};
+          for (const Contact& c : r.contacts) {
+            const Vec3 push = groundIsA ? Vec3(-c.normal) : c.normal;  // the box's way out
+            EXPECT_LT(angleBetween(push, Vec3::UnitZ()), 1e-6) << what << ": contact at " << c.point.transpose();
+            EXPECT_NEAR(c.depth, kSunk, rounding) << what;
+            for (int k = 0; k < 4; ++k) {
+              const Vec3 corner = pose.apply(Vec3(k & 1 ? 0.25 : -0.25, k & 2 ? 0.25 : -0.25, -0.25));
+              if ((c.point - (corner + 0.5 * kSunk * Vec3::UnitZ())).norm() < 1e-9) found[k] = true;
+            }
+          }
+          EXPECT_TRUE(found[0] && found[1] && found[2] && found[3]) << what << ": " << r.contacts.size() << " contacts";
+        }
+      }
+    }
   }
 }
 
