@@ -21,10 +21,14 @@ struct Closest {
   TrianglePoint point{};
 };
 
-Closest closestOnBody(const CollisionBody& body, const Vec3& p, ContainmentScratch& s) {
+// Only triangles nearer than maxDistance are looked for (infinity: all); none found leaves the
+// distance at infinity.
+Closest closestOnBody(const CollisionBody& body, const Vec3& p, ContainmentScratch& s,
+                      double maxDistance = std::numeric_limits<double>::infinity()) {
   const SphereTree& tree = body.sphereTree();
   const TriangleMesh& mesh = body.mesh();
   Closest best;
+  const double reach = maxDistance * maxDistance;
   auto lowerBound = [&](std::uint32_t n) { return std::max(0.0, (p - tree.center(n)).norm() - tree.radius[n]); };
   auto later = [](const auto& x, const auto& y) { return x.first > y.first; };  // min-heap
   s.heap.clear();
@@ -33,19 +37,19 @@ Closest closestOnBody(const CollisionBody& body, const Vec3& p, ContainmentScrat
     std::pop_heap(s.heap.begin(), s.heap.end(), later);
     const auto [lb, n] = s.heap.back();
     s.heap.pop_back();
-    if (lb * lb >= best.distanceSquared) break;
+    if (lb * lb >= std::min(best.distanceSquared, reach)) break;
     if (tree.childCount[n] == 0) {
       for (std::uint32_t i = tree.triangleOffsets[n]; i < tree.triangleOffsets[n + 1]; ++i) {
         const std::uint32_t t = tree.triangleList[i];
         const TrianglePoint tp = closestPointOnTriangle(p, mesh.corner(t, 0), mesh.corner(t, 1), mesh.corner(t, 2));
-        if (tp.distanceSquared < best.distanceSquared) best = {tp.distanceSquared, t, tp};
+        if (tp.distanceSquared < best.distanceSquared && tp.distanceSquared < reach) best = {tp.distanceSquared, t, tp};
       }
       continue;
     }
     for (std::uint32_t k = 0; k < tree.childCount[n]; ++k) {
       const std::uint32_t child = tree.firstChild[n] + k;
       const double clb = lowerBound(child);
-      if (clb * clb < best.distanceSquared) {
+      if (clb * clb < std::min(best.distanceSquared, reach)) {
         s.heap.emplace_back(clb, child);
         std::push_heap(s.heap.begin(), s.heap.end(), later);
       }
@@ -112,8 +116,15 @@ Vec3 featurePseudonormal(const CollisionBody& body, const Vec3& p, const Closest
 }  // namespace
 
 FieldValue exactBodyField(const CollisionBody& body, const Vec3& pLocal, ContainmentScratch& scratch) {
-  const Closest c = closestOnBody(body, pLocal, scratch);
   FieldValue f;
+  exactBodyFieldWithin(body, pLocal, std::numeric_limits<double>::infinity(), scratch, f);
+  return f;
+}
+
+bool exactBodyFieldWithin(const CollisionBody& body, const Vec3& pLocal, double maxDistance, ContainmentScratch& scratch,
+                          FieldValue& f) {
+  const Closest c = closestOnBody(body, pLocal, scratch, maxDistance);
+  if (!std::isfinite(c.distanceSquared)) return false;
   const double d = std::sqrt(c.distanceSquared);
   const Vec3 pseudo = featurePseudonormal(body, pLocal, c, scratch);
   const Vec3 away = pLocal - c.point.point;
@@ -124,7 +135,7 @@ FieldValue exactBodyField(const CollisionBody& body, const Vec3& pLocal, Contain
   // pseudonormal.
   f.gradient = d > 1e-12 * body.diagonal() ? Vec3((inside ? -away : away) / d) : pseudo;
   f.errorBound = 0.0;
-  return f;
+  return true;
 }
 
 namespace {

@@ -34,6 +34,11 @@ struct FieldValue {
   double errorBound = 0.0;
 };
 FieldValue exactBodyField(const CollisionBody& body, const Vec3& pLocal, ContainmentScratch& scratch);
+/// exactBodyField where the surface lies within maxDistance of p, searching only that far (the
+/// cost of a point far from the surface is then a few sphere tests); false, `f` untouched, where
+/// it does not.
+bool exactBodyFieldWithin(const CollisionBody& body, const Vec3& pLocal, double maxDistance, ContainmentScratch& scratch,
+                          FieldValue& f);
 
 
 /// Containment contacts (A's frame, normal from B toward A) when A lies wholly inside B or B

@@ -1406,6 +1406,9 @@ bool cornersInsideContacts(const PatchSide& nonConvex, const PatchSide& convex, 
                            std::vector<Contact>& out) {
   const TriangleMesh& mesh = convex.body.mesh();
   const double tolerance = 1e-9 * (nonConvex.body.diagonal() + convex.body.diagonal());
+  // A corner deeper than the convex body's own size is the containment rule's case; searching
+  // only that far keeps a corner far from the surface at a few sphere tests.
+  const double reach = convex.body.sphereTree().radius[0];
   bool anyInside = false;
   for (std::uint32_t id : convex.body.spherePatchVertices(convex.sphere)) {
     const Vec3 v = convex.toA(mesh.vertices[id]);
@@ -1416,8 +1419,8 @@ bool cornersInsideContacts(const PatchSide& nonConvex, const PatchSide& convex, 
       continue;
     }
     const Vec3 local = nonConvex.rotToA ? Vec3(nonConvex.rotToA->transpose() * (v - nonConvex.shift)) : v;
-    const detail::FieldValue f = detail::exactBodyField(nonConvex.body, local, scratch);
-    const bool inside = f.distance < -tolerance;
+    detail::FieldValue f;
+    const bool inside = detail::exactBodyFieldWithin(nonConvex.body, local, reach, scratch, f) && f.distance < -tolerance;
     probed.push_back({id, inside});
     if (!inside) continue;
     anyInside = true;
