@@ -653,6 +653,32 @@ TEST(CoarseContacts, BoxOnTheFloorOfAnLShapedBodyIsHeldUpByItsCornersAtEveryBudg
   }
 }
 
+// A ball (an icosphere of radius 0.25: a convex body whose patches above the leaves are curved)
+// 0.5 mm deep on the L's floor, touching its wall. Oracle, by construction: the ball's lowest
+// vertex is the one point inside the floor, so every contact lies at the ball (within its radius
+// of its centre), pushes it up or away from the wall, and is no deeper than 0.5 mm. Before, the
+// L's far corners (2.5 m away) lay behind the few face planes of the ball's leaves and came back
+// as contacts 0.1-0.9 m "deep" at 256 tests and up (the ball rolled 60 cm off the wall), and at
+// 16-64 tests the curved patches took the L's hull: pushed down, the ball fell through.
+TEST(CoarseContacts, BallInTheCornerOfAnLShapedBodyGetsContactsOnlyWhereItIs) {
+  static const CollisionBody ground = octreeBodyForCfm(test::makeLShapedBody());
+  static const CollisionBody ball = octreeBodyForCfm(makeIcosphere(0.25, 2));
+  constexpr double kSunk = 0.0005;
+  const Vec3 centre(0.75, 0.3, 0.25 - kSunk);
+  const double rounding = 1e-9 * (ground.diagonal() + ball.diagonal());
+  for (const std::uint64_t budget : {std::uint64_t(16), std::uint64_t(64), std::uint64_t(256), std::uint64_t(1024), kUnlimitedTests}) {
+    const QueryResult r = queryContacts(ground, Pose{}, ball, Pose{Quat::Identity(), centre}, settingsFor(ContactModel::kCfm, budget));
+    const std::string what = "cfm at " + std::to_string(budget) + " tests";
+    EXPECT_FALSE(r.contacts.empty()) << what;
+    for (const Contact& c : r.contacts) {
+      EXPECT_LE((c.point - centre).norm(), 0.25 + kSunk) << what << ": contact at " << c.point.transpose();
+      EXPECT_LE(c.depth, kSunk + rounding) << what << ": contact at " << c.point.transpose();
+      const Vec3 push = -c.normal;  // the ball is B: it leaves along -n
+      EXPECT_TRUE(push.z() > 0.99 || push.x() < -0.99) << what << ": pushed along " << push.transpose();
+    }
+  }
+}
+
 // A contact-tree sample half a coarse cell below one face of a thin body lies past its far face,
 // outside it: the other body's field there is no penetration. A flat box (1.08 x 0.6 x 0.45) on
 // a slab, tipped onto one long edge, got contacts 5-10 cm "deep" at 16-42 tests from such points
