@@ -1411,9 +1411,10 @@ bool cornersInsideContacts(const PatchSide& nonConvex, const PatchSide& convex, 
                            std::vector<Contact>& out) {
   const TriangleMesh& mesh = convex.body.mesh();
   const double tolerance = 1e-9 * (nonConvex.body.diagonal() + convex.body.diagonal());
-  // A corner deeper than the convex body's own size is the containment rule's case; searching
-  // only that far keeps a corner far from the surface at a few sphere tests.
-  const double reach = convex.body.sphereTree().radius[0];
+  // A vertex deeper in N than its patch's sphere is large is found by a coarser pair, or is the
+  // containment rule's case; searching only that far keeps a vertex far from N's surface at a
+  // few sphere tests (with the whole body's radius, the 200-body bin's p99 frame doubled).
+  const double reach = convex.radius;
   bool anyInside = false;
   // A faceted patch's vertices; a curved patch's support vertices and, on a non-convex body, its
   // inner vertices (the flank of a bump lies between the hull's).
@@ -1589,14 +1590,17 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
     const bool convexA = bodyA.isConvexPolyhedron(), convexB = bodyB.isConvexPolyhedron();
     // A closed non-convex body against a convex body's faceted patch: the convex corners inside the
     // body and the body's vertices inside the convex one, each at its exact depth, are the contact.
-    // Where the non-convex side's patch has a pocket, or the other side is a faceted patch (at most
-    // 32 vertices: cheap to probe, and its corners, not a separating-axis contact at the spheres'
-    // D&O point, are where it touches -- a box landing on one corner on a convex piece of a bin's
-    // floor stood balanced on such contacts). A convex piece against a curved patch (an icosphere's,
-    // a fandisk's: up to 1,024 support vertices) is its own hull, and the separating axis answers
-    // it as before (probing every such pair cost the 200-body bin 45 % more time per frame).
+    // Where a patch of the pair has a pocket, or the other side is a faceted patch (at most 32
+    // vertices: cheap to probe, and its corners, not a separating-axis contact at the spheres' D&O
+    // point, are where it touches -- a box landing on one corner on a convex piece of a bin's floor
+    // stood balanced on such contacts). A convex piece against a curved patch (an icosphere's, a
+    // fandisk's: up to 1,024 support vertices) is its own hull, and the separating axis answers it
+    // as before (probing those pairs too cost the 200-body bin 45 % more CPU per frame and doubled
+    // its p99 frame; it did screw cfm's nut down its bolt, which now jams).
+    const bool bothClosedNonConvex = !convexA && !convexB && bodyA.isClosed() && bodyB.isClosed();
     const bool closedA = !convexA && bodyA.isClosed() &&
-                         ((!convexB && bodyB.isClosed()) || (convexB && (hasPocket(sideA) || sideB.faceted)));
+                         ((bothClosedNonConvex && (hasPocket(sideA) || hasPocket(sideB) || sideA.faceted || sideB.faceted)) ||
+                          (convexB && (hasPocket(sideA) || sideB.faceted)));
     const bool closedB = !closedA && !convexB && bodyB.isClosed() && convexA && (hasPocket(sideB) || sideA.faceted);
     if (closedA || closedB) {
       const PatchSide& body = closedA ? sideA : sideB;
