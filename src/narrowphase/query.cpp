@@ -2251,6 +2251,7 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
         // Coplanar triangles facing the same way are flush side by side (two boxes' aligned side
         // faces), not pressed against each other: no contact.
         if (hit.coplanar && hit.normalA.dot(hit.normalB) > 0.0) continue;
+        if (hit.touching) continue;
         const auto pairIndex = static_cast<std::uint32_t>(s.volumePairs.size());
         s.volumePairs.push_back({ref.ta, ref.tb, 0, pairIndex});
         s.pairCoplanar.push_back(hit.coplanar ? 1 : 0);
@@ -2293,7 +2294,11 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
     const std::uint32_t patch = s.patchParent[kc.pair];
     if (s.patchHasVertices[patch] != 0) continue;
     kc.contact.normal = s.patchNormal[patch];
-    kc.contact.depth = s.patchDepth[patch];
+    // Coplanar faces pressed together (their patches hold no crossing pair) touch: no volume lies
+    // between them. (Their pieces' areas differ -- a wall against a box's face -- and the volume
+    // formula read that difference as 13-26 mm of depth, pushing a box off the wall it stood flush
+    // against.)
+    kc.contact.depth = s.pairCoplanar[kc.pair] != 0 ? 0.0 : s.patchDepth[patch];
     if (s.patchCurved[patch] != 0) localNormal(s, kc.pair, kc.contact);
     out.push_back(kc.contact);
   }

@@ -66,6 +66,7 @@ bool intersectTriangles(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Ve
                         const Vec3& b2, double epsAbs, TriangleIntersection& out) noexcept {
   out.count = 0;
   out.coplanar = false;
+  out.touching = false;
   const Vec3 a[3] = {a0, a1, a2};
   const Vec3 b[3] = {b0, b1, b2};
 
@@ -94,6 +95,10 @@ bool intersectTriangles(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Ve
     out.coplanar = true;
     return clipCoplanar(a, b, nB, epsAbs, out);
   }
+  auto straddles = [](const double* d) {
+    return std::min({d[0], d[1], d[2]}) < 0.0 && std::max({d[0], d[1], d[2]}) > 0.0;
+  };
+  out.touching = !straddles(dA) || !straddles(dB);
 
   Vec3 segA[3];
   Vec3 segB[3];

@@ -22,6 +22,10 @@ struct TriangleIntersection {
   std::array<Vec3, 9> points;
   std::uint32_t count = 0;
   bool coplanar = false;
+  /// Not coplanar, and one triangle has no corner strictly on each side of the other's plane: they
+  /// meet where an edge or a corner of one lies in the other's plane, without crossing it (a face
+  /// resting edge-on against another). No volume lies between them there.
+  bool touching = false;
   /// Penetration of A's corners below B's plane: max(0, max_i -nB . (a_i - b_0)), and the
   /// same for B's corners below A's plane (unit outward face normals nA, nB).
   double penetrationBelowB = 0.0;

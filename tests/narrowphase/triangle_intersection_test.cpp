@@ -109,10 +109,16 @@ TEST(TriangleIntersection, CoplanarOverlapGivesTheOverlapPolygon) {
 TEST(TriangleIntersection, TouchingAndParallelCases) {
   TriangleIntersection out;
   const Vec3 a0(0, 0, 0), a1(1, 0, 0), a2(0, 1, 0);
-  // B's corner touches A's interior from above: one point.
+  // B's corner touches A's interior from above: one point, touching (B has no corner below A).
   EXPECT_TRUE(intersectTriangles(a0, a1, a2, Vec3(0.2, 0.2, 0), Vec3(0.2, 0.2, 1), Vec3(0.5, 0.1, 1), 1e-12, out));
   EXPECT_LT((out.points[0] - Vec3(0.2, 0.2, 0)).norm(), 1e-12);
   EXPECT_LT((out.points[1] - Vec3(0.2, 0.2, 0)).norm(), 1e-12);
+  EXPECT_TRUE(out.touching);
+  // B standing on A with an edge in A's plane: a segment, touching; pushed 0.1 through: crossing.
+  EXPECT_TRUE(intersectTriangles(a0, a1, a2, Vec3(0.1, 0.2, 0), Vec3(0.6, 0.2, 0), Vec3(0.3, 0.2, 1), 1e-12, out));
+  EXPECT_TRUE(out.touching);
+  EXPECT_TRUE(intersectTriangles(a0, a1, a2, Vec3(0.1, 0.2, -0.1), Vec3(0.6, 0.2, -0.1), Vec3(0.3, 0.2, 1), 1e-12, out));
+  EXPECT_FALSE(out.touching);
   // Parallel planes 1e-3 apart: nothing.
   EXPECT_FALSE(intersectTriangles(a0, a1, a2, a0 + Vec3(0, 0, 1e-3), a1 + Vec3(0, 0, 1e-3), a2 + Vec3(0, 0, 1e-3), 1e-12, out));
   // Degenerate triangle: never.
