@@ -252,8 +252,8 @@ using CellPair = NodePair<ContactCell, ContactCell>;
 
 // ---------------------------------------------------------------------------------------------
 
-// A convex body's corner tested against a closed non-convex body in one answer
-// (cornersInsideContacts), and whether it was inside.
+// A vertex tested against a closed non-convex body in one answer (cornersInsideContacts), and
+// whether it was inside.
 struct ProbedCorner {
   std::uint32_t vertex;
   bool inside;
@@ -322,8 +322,8 @@ struct QueryScratch::Impl {
   std::array<std::vector<std::uint32_t>, 2> triedVertices;
   std::vector<Contact> vertexContacts;
   std::vector<std::uint8_t> patchHasVertices;
-  // Corners of a convex body's patches already probed against a closed non-convex body's exact
-  // field in this answer (cornersInsideContacts), per side (A, B).
+  // Vertices already probed against a closed non-convex body's exact field in this answer
+  // (cornersInsideContacts), per body (A, B).
   std::array<std::vector<ProbedCorner>, 2> probedCorners;
   // Separating-axis contacts of such pairs without a vertex inside, kept only if no pair has one.
   std::vector<Contact> edgeContacts;
@@ -1396,16 +1396,17 @@ bool cornersOverFlatPatchContacts(const PatchSide& flat, const PatchSide& convex
   return out.size() > before;
 }
 
-// Corners of a convex body's faceted patch that lie inside a closed non-convex body, by that body's
-// exact signed distance (detail::exactBodyField: nearest triangle, signed by the angle-weighted
-// pseudonormal). Each is a contact at its own depth, along the field's gradient (out through the
-// nearest surface), error bound 0. Between a convex patch and a non-convex one the separating-axis
-// choice treats the non-convex side as its convex hull, and a box standing in the hull's pocket
-// (on the floor of an L-shaped body, beside its wall) overlaps that hull least downward, through
-// the floor: its contact pushed the box into the floor, 0.999 deep, and at 16-64 tests per frame
-// it fell through (cfm and exact alike). Each corner is probed once per answer (`probed`: the
-// convex side's corners tested so far, with the answer), by the pairs whose non-convex sphere
-// holds it; its contact is added once. Returns whether a corner in this pair's sphere is inside.
+// Vertices of a patch (a convex body's, faceted or curved, or a second closed non-convex body's)
+// that lie inside a closed non-convex body N, by N's exact signed distance
+// (detail::exactBodyFieldWithin: nearest triangle, signed by the angle-weighted pseudonormal).
+// Each is a contact at its own depth, along the field's gradient (out through the nearest
+// surface), error bound 0. The separating-axis choice treats N's patch as its convex hull, and a
+// box standing in the hull's pocket (on the floor of an L-shaped body, beside its wall) overlaps
+// that hull least downward, through the floor: its contact pushed the box into the floor, 0.999
+// deep, and at 16-64 tests per frame it fell through (cfm and exact alike). Each vertex is probed
+// once per answer (`probed`: the patch body's vertices tested so far, with the answer), by the
+// pairs whose N sphere holds it; its contact is added once. Returns whether a vertex in this
+// pair's sphere is inside.
 bool cornersInsideContacts(const PatchSide& nonConvex, const PatchSide& convex, bool convexIsB, const Contact& c,
                            detail::ContainmentScratch& scratch, std::vector<ProbedCorner>& probed,
                            std::vector<Contact>& out) {
@@ -1447,14 +1448,6 @@ bool cornersInsideContacts(const PatchSide& nonConvex, const PatchSide& convex, 
   return anyInside;
 }
 
-bool facetedPatchIsConvex(const CollisionBody& body, std::uint32_t sphere);
-
-// Whether a patch is not its own hull: a faceted one that is not convex, a curved one with inner
-// vertices (vertices inside its hull, which only a non-convex patch has).
-bool hasPocket(const PatchSide& side) {
-  return side.faceted ? !facetedPatchIsConvex(side.body, side.sphere) : !side.body.sphereInnerVertices(side.sphere).empty();
-}
-
 // Whether a faceted patch is convex: every one of its vertices on or behind the plane of every one
 // of its triangles. A piece of a non-convex body can be (a step's edge), and then its hull is its
 // body there; one that holds a concave corner (an L-shaped body's floor and wall) is not.
@@ -1469,6 +1462,12 @@ bool facetedPatchIsConvex(const CollisionBody& body, std::uint32_t sphere) {
       if (n.dot(mesh.vertices[v]) > offset + tolerance) return false;
   }
   return true;
+}
+
+// Whether a patch is not its own hull: a faceted one that is not convex, a curved one with inner
+// vertices (vertices inside its hull, which only a non-convex patch has).
+bool hasPocket(const PatchSide& side) {
+  return side.faceted ? !facetedPatchIsConvex(side.body, side.sphere) : !side.body.sphereInnerVertices(side.sphere).empty();
 }
 
 // Two faceted patches whose least-overlap axis shows zero depth, and that have no faces facing
@@ -1588,8 +1587,8 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
     // single patch contact held the Figure 6 bunny 95 deg from the exact run's pose; with their
     // vertices, 13 deg (`clod experiment landing`).
     const bool convexA = bodyA.isConvexPolyhedron(), convexB = bodyB.isConvexPolyhedron();
-    // A closed non-convex body against a convex body's faceted patch: the convex corners inside the
-    // body and the body's vertices inside the convex one, each at its exact depth, are the contact.
+    // A closed non-convex body against a convex body's patch or a second closed non-convex body:
+    // the vertices of each inside the other, each at its exact depth, are the contact.
     // Where a patch of the pair has a pocket, or the other side is a faceted patch (at most 32
     // vertices: cheap to probe, and its corners, not a separating-axis contact at the spheres' D&O
     // point, are where it touches -- a box landing on one corner on a convex piece of a bin's floor
@@ -1597,13 +1596,15 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
     // fandisk's: up to 1,024 support vertices) is its own hull, and the separating axis answers it
     // as before (probing those pairs too cost the 200-body bin 45 % more CPU per frame and doubled
     // its p99 frame; it did screw cfm's nut down its bolt, which now jams).
-    const bool bothClosedNonConvex = !convexA && !convexB && bodyA.isClosed() && bodyB.isClosed();
-    const bool closedA = !convexA && bodyA.isClosed() &&
-                         ((bothClosedNonConvex && (hasPocket(sideA) || hasPocket(sideB) || sideA.faceted || sideB.faceted)) ||
-                          (convexB && (hasPocket(sideA) || sideB.faceted)));
-    const bool closedB = !closedA && !convexB && bodyB.isClosed() && convexA && (hasPocket(sideB) || sideA.faceted);
+    const bool closedNonConvexA = !convexA && bodyA.isClosed(), closedNonConvexB = !convexB && bodyB.isClosed();
+    const bool pocketA = closedNonConvexA && hasPocket(sideA), pocketB = closedNonConvexB && hasPocket(sideB);
+    const bool closedA = closedNonConvexA &&
+                         ((closedNonConvexB && (pocketA || pocketB || sideA.faceted || sideB.faceted)) ||
+                          (convexB && (pocketA || sideB.faceted)));
+    const bool closedB = !closedA && closedNonConvexB && convexA && (pocketB || sideA.faceted);
     if (closedA || closedB) {
       const PatchSide& body = closedA ? sideA : sideB;
+      const bool bodyPocket = closedA ? pocketA : pocketB;
       const PatchSide& convex = closedA ? sideB : sideA;  // (or a second closed non-convex body: B)
       bool any = cornersInsideContacts(body, convex, closedA, c, s.containment, s.probedCorners[closedA ? 1 : 0], out);
       if (!convex.body.isConvexPolyhedron()) {
@@ -1629,8 +1630,7 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
       // its pair's D&O point, up to a sphere away from where the bodies meet (a box balanced on
       // one corner on a bin's floor got three such contacts around it at an unlimited budget and
       // stood on them).
-      if (body.body.sphereFaceNormals(body.sphere).size() == 1 || (body.faceted && !facetedPatchIsConvex(body.body, body.sphere)))
-        continue;
+      if (body.body.sphereFaceNormals(body.sphere).size() == 1 || (body.faceted && bodyPocket)) continue;
       const Extent e = convex.vertexExtent(c.normal);
       if (c.depth > e.hi - e.lo) continue;
       if (sideA.faceted && sideB.faceted && grazesAtZeroDepth(sideA, sideB, c)) continue;
