@@ -45,4 +45,8 @@ MassProperties computeMassProperties(const TriangleMesh& mesh, double density = 
 /// made from it still has a plausible mass and inertia. Other errors propagate.
 MassProperties computeMassPropertiesOrBoundingBox(const TriangleMesh& mesh, double density = 1.0);
 
+/// The solid ball of `radius` (> 0 and finite, else kInvalidArgument) about the origin:
+/// volume 4/3 pi r^3, centre at the origin, inertia 2/5 m r^2 on every axis.
+MassProperties ballMassProperties(double radius, double density = 1.0);
+
 }  // namespace clod

@@ -22,6 +22,11 @@ TriangleMesh makeBox(const Vec3& halfExtents);
 /// subdivisions <= 10. O(triangles) time and memory.
 TriangleMesh makeIcosphere(double radius, std::uint32_t subdivisions);
 
+/// The mesh of a ball body (RigidBodyDesc::ballRadius): makeIcosphere scaled so that every face's
+/// plane is at least `radius` from the origin, a polyhedron that encloses the ball (its vertices
+/// reach 1.8 % beyond it at 2 subdivisions). Same limits as makeIcosphere.
+TriangleMesh makeBallHull(double radius, std::uint32_t subdivisions);
+
 /// Cylinder along z from -halfHeight to +halfHeight with `segments` sides (3 <= segments <= 2^28),
 /// capped by triangle fans around a centre vertex: 2 * segments + 2 vertices, 4 * segments
 /// triangles. Ring vertices lie on the circle of `radius` (an inscribed regular prism), the first

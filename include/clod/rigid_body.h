@@ -43,6 +43,12 @@ struct RigidBodyDesc {
   Quat orientation = Quat::Identity();  ///< normalised by World::addBody
   Vec3 velocity = Vec3::Zero();         ///< centre-of-mass velocity
   Vec3 angularVelocity = Vec3::Zero();  ///< world frame, rad/s
+  /// When > 0, the body is a ball of this radius about its mesh origin, which must be its centre
+  /// of mass; its mesh encloses the ball (every face's plane at least this far from the origin,
+  /// makeBallHull). The world keeps each contact's normal and the other body's surface point and
+  /// puts the ball's side on the ball (docs/dynamics.md, "Balls"): a ball rolls as a ball, not
+  /// as its polyhedron, which rests on a facet. Two balls touch analytically, without a query.
+  double ballRadius = 0.0;
 };
 
 /// A body's state as the world reports it (same frames as RigidBodyDesc).

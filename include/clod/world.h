@@ -169,6 +169,7 @@ struct WorldSettings {
   /// body rolling without slip loses no energy, so without it a bunny landed on its round back
   /// rocked for 5 s and more with every model (docs/dynamics.md, "Rolling resistance", says why
   /// 0.3 %); a body rolls beyond tan(slope) = this x diagonal / lever. 0 = none; >= 0, finite.
+  /// A pair with a ball (RigidBodyDesc::ballRadius) has none: a rigid ball rolls for ever.
   double rollingResistanceRel = 0.003;
   /// Split-impulse penetration correction: fraction of (depth - slop) removed per substep
   /// (Baumgarte-like factor, in (0, 1]) and the allowed penetration, relative to the smaller
@@ -306,10 +307,11 @@ public:
 
   /// Adds a body; returns its id (0, 1, ...). Throws clod::Error(kInvalidArgument) naming the
   /// body for a null shape, a non-positive or non-finite mass, a non-positive-definite inertia
-  /// of a dynamic body, restitution outside [0, 1], negative friction, or non-finite state.
+  /// of a dynamic body, restitution outside [0, 1], negative friction, non-finite state, or a
+  /// ball (ballRadius > 0) whose mesh does not enclose it or whose centre of mass is off its origin.
   BodyId addBody(const RigidBodyDesc& desc);
   /// Adds a body whose shape is desc.shape scaled uniformly by `scale` (scaleCollisionBody; > 0
-  /// and finite). Everything else in `desc` describes the scaled body: centerOfMass in the scaled
+  /// and finite). Everything else in `desc` describes the scaled body: centerOfMass and ballRadius in the scaled
   /// mesh coordinates, mass and inertia of the scaled body (for a uniform density they grow as
   /// scale^3 and scale^5; mass_properties.h computes them from the scaled mesh). Bodies added with
   /// the same shape and scale share one scaled copy. desc(id).shape is the scaled shape.

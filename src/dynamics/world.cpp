@@ -15,6 +15,7 @@
 #include "clod/error.h"
 #include "clod/quaternion.h"
 #include "clod/query.h"
+#include "dynamics/ball_contacts.h"
 #include "narrowphase/separation.h"
 
 namespace clod {
@@ -93,6 +94,27 @@ std::uint64_t substepAllowance(std::uint64_t budget, std::uint64_t spent, std::u
   return std::min(share, target > spent ? target - spent : 0);
 }
 
+// A ball body (RigidBodyDesc::ballRadius) is one whose mesh encloses the ball about its origin,
+// and a dynamic one turns about that origin: the contacts put on the ball would otherwise miss
+// what the narrow phase saw, or push off-centre.
+template <class Fail>
+void requireBallHull(const RigidBodyDesc& d, Fail bad) {
+  const double r = d.ballRadius;
+  // Rounding of the hull's planes: ~1e-15 of the radius; a user's hull may be a hair inside.
+  const double slack = 1e-9 * r;
+  if (d.type == BodyType::kDynamic && d.centerOfMass.norm() > slack)
+    bad("a ball's centre of mass must be its mesh origin (ballRadius)");
+  const TriangleMesh& mesh = d.shape->mesh();
+  for (const Triangle& t : mesh.triangles) {
+    const Vec3 &p0 = mesh.vertices[t[0]], &p1 = mesh.vertices[t[1]], &p2 = mesh.vertices[t[2]];
+    const Vec3 n = (p1 - p0).cross(p2 - p0);
+    // Outward faces (counter-clockwise seen from outside) have the origin behind them.
+    if (!(n.dot(p0) >= (r - slack) * n.norm()))
+      bad("the mesh must enclose the ball of ballRadius " + std::to_string(r) +
+          " about its origin (every face's plane at least that far; makeBallHull)");
+  }
+}
+
 Mat3 worldInverseInertia(const Mat3& invInertiaLocal, const Quat& q) {
   const Mat3 r = q.toRotationMatrix();
   return r * invInertiaLocal * r.transpose();
@@ -134,6 +156,20 @@ struct Body {
     return Aabb{c - h, c + h};
   }
 };
+
+// A contact's point on A (on B): its anchor in the body -- or, on a ball (RigidBodyDesc::
+// ballRadius), the ball's surface point along the normal (-normal on A, +normal on B). A ball has
+// no material contact point: it rolls, and an anchor turning with it would lift off the ground
+// as a cycloid, opening the contact (docs/dynamics.md, "Balls").
+Vec3 ballSupport(const Body& ball, const Vec3& towardOther) {
+  return ball.pose().translation + ball.desc.ballRadius * towardOther;
+}
+Vec3 pointOnA(const Body& a, const Vec3& anchor, const Vec3& normal) {
+  return a.desc.ballRadius > 0.0 ? ballSupport(a, -normal) : Vec3(a.x + a.q * anchor);
+}
+Vec3 pointOnB(const Body& b, const Vec3& anchor, const Vec3& normal) {
+  return b.desc.ballRadius > 0.0 ? ballSupport(b, normal) : Vec3(b.x + b.q * anchor);
+}
 
 // The Coulomb coefficient of a contact between two bodies: the geometric mean of theirs.
 double pairFriction(const Body& a, const Body& b) { return std::sqrt(a.desc.friction * b.desc.friction); }
@@ -276,6 +312,7 @@ struct World::Impl {
   BroadPhaseScratch bpScratch;
   QueryScratch scratch;
   QueryResult result;
+  detail::ContainmentScratch ballScratch;  // putContactsOnBall's field queries
   std::vector<std::pair<PairState*, std::array<BodyId, 2>>> order;
   std::vector<std::pair<PairState*, std::array<BodyId, 2>>> solveOrder;
   std::vector<Vec3> savedV, savedW, dV, dW;
@@ -406,6 +443,8 @@ BodyId World::addBody(const RigidBodyDesc& d) {
   if (!finite(d.position) || !finite(d.velocity) || !finite(d.angularVelocity) || !d.orientation.coeffs().allFinite() ||
       !finite(d.centerOfMass))
     bad("state must be finite");
+  if (!(d.ballRadius >= 0.0 && std::isfinite(d.ballRadius))) bad("ballRadius must be >= 0 and finite");
+  if (d.ballRadius > 0.0) requireBallHull(d, bad);
   const Quat& q = d.orientation;
   const std::optional<Quat> orientation = unitQuaternion(q.w(), q.x(), q.y(), q.z());
   if (!orientation) bad("orientation quaternion is zero");
@@ -590,6 +629,38 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       continue;
     }
     pr.provenApart = false;
+    if (a.desc.ballRadius > 0.0 && bb.desc.ballRadius > 0.0) {
+      // Two balls: one exact contact, one test (docs/dynamics.md, "Balls").
+      double gap = 0.0;
+      const Contact c = detail::ballBallContact(a.pose().translation, a.desc.ballRadius, bb.pose().translation,
+                                                bb.desc.ballRadius, gap);
+      const std::uint64_t cost = limited ? std::min<std::uint64_t>(remaining, 1) : 1;
+      remaining -= cost;
+      report.budgetSpent += cost;
+      ++report.testsSpent;
+      ++report.unitsWorked;
+      pr.tests += 1;
+      pr.level = 0;
+      pr.finished = true;
+      pr.fallbackPairs = 0;
+      pr.skipped = pr.reused = false;
+      p->interrupted = false;
+      p->reusable = false;
+      p->apartBy = std::max(gap, 0.0);
+      p->queriedAt = a.pose().inverse() * bb.pose();
+      p->keptFiner = false;
+      p->stale = 0;
+      p->fresh = true;
+      p->previous.swap(p->contacts);
+      p->contacts.clear();
+      if (gap <= 0.0) {
+        SolverContact cp;
+        cp.c = c;
+        p->contacts.push_back(cp);
+      }
+      --left;
+      continue;
+    }
     // A pair's even share of what the substep has left (limited budgets).
     const std::uint64_t evenShare = limited ? std::max<std::uint64_t>(1, remaining / left) : 0;
     // A manifold is reused while the bodies have not moved against each other and a new query
@@ -781,6 +852,17 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
     p->fresh = true;
     p->previous.swap(p->contacts);
     p->contacts.clear();
+    if (a.desc.ballRadius > 0.0 || bb.desc.ballRadius > 0.0) {
+      // A ball's contacts are the ball's, not its polyhedron's (docs/dynamics.md, "Balls").
+      const bool ballIsA = a.desc.ballRadius > 0.0;
+      const Body& ball = ballIsA ? a : bb;
+      const Body& other = ballIsA ? bb : a;
+      const std::uint32_t fieldQueries = detail::putContactsOnBall(result.contacts, ball.pose().translation, ball.desc.ballRadius,
+                                                                   ballIsA, *other.desc.shape, other.pose(), ballScratch);
+      report.testsSpent += fieldQueries;
+      report.unitsWorked += fieldQueries;
+      pr.tests += fieldQueries;
+    }
     for (const Contact& c : result.contacts) {
       SolverContact cp;
       cp.c = c;
@@ -866,12 +948,15 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       // Both anchors moved with their bodies: their offset along the normal is this point's own
       // separation now (a tilt makes one side deeper and the other shallower), and their midpoint
       // is where the impulses act -- one point for both bodies, so impulses stay equal and
-      // opposite about one point and momentum is conserved exactly.
-      const Vec3 pA = a.x + a.q * cp.anchorA;
-      const Vec3 pB = b.x + b.q * cp.anchorB;
+      // opposite about one point and momentum is conserved exactly. Against a ball they act at
+      // the ball's point, under its centre: the other body's anchor lags behind a rolling ball,
+      // and a push between the two would brake it (rolling resistance the ball does not have).
+      const Vec3 pA = pointOnA(a, cp.anchorA, n);
+      const Vec3 pB = pointOnB(b, cp.anchorB, n);
       cp.separation = (pA - pB).dot(n);
       cp.speculative = std::max(0.0, cp.separation) / h;
-      const Vec3 point = 0.5 * (pA + pB);
+      const bool ballA = a.desc.ballRadius > 0.0, ballB = b.desc.ballRadius > 0.0;
+      const Vec3 point = ballA == ballB ? Vec3(0.5 * (pA + pB)) : ballA ? pA : pB;
       cp.rA = point - a.x;
       cp.rB = point - b.x;
       tangents(n, cp.t1, cp.t2);
@@ -984,7 +1069,7 @@ void World::Impl::persistContacts(PairState& p, const Body& a, const Body& b, do
     SolverContact* match = nullptr;
     for (SolverContact& old : p.previous) {
       if (old.matched || old.c.normal.dot(n) < kWarmStartNormalCos) continue;
-      const Vec3 mid = 0.5 * (a.x + a.q * old.anchorA + b.x + b.q * old.anchorB);
+      const Vec3 mid = 0.5 * (pointOnA(a, old.anchorA, old.c.normal) + pointOnB(b, old.anchorB, old.c.normal));
       const double d = (mid - cp.c.point).norm();
       if (d < best) {
         best = d;
@@ -997,7 +1082,7 @@ void World::Impl::persistContacts(PairState& p, const Body& a, const Body& b, do
     match->matched = true;
     cp.lambdaN = match->lambdaN;
     cp.frictionImpulse = match->frictionImpulse;
-    const Vec3 gap = a.x + a.q * match->anchorA - b.x - b.q * match->anchorB;
+    const Vec3 gap = pointOnA(a, match->anchorA, n) - pointOnB(b, match->anchorB, n);
     const double open = gap.dot(n);
     const bool held = open < drift && (gap - open * n).norm() < drift;
     const bool standsFor = best < drift && std::abs(-open - cp.c.depth) <= cp.c.errorBound + slop;
@@ -1030,7 +1115,7 @@ void World::Impl::carryValidContacts(PairState& p, const Body& a, const Body& b,
   if (fresh == 0 && !provedNothing) return;
   for (const SolverContact& old : p.previous) {
     if (old.matched) continue;
-    const Vec3 pA = a.x + a.q * old.anchorA, pB = b.x + b.q * old.anchorB;
+    const Vec3 pA = pointOnA(a, old.anchorA, old.c.normal), pB = pointOnB(b, old.anchorB, old.c.normal);
     const Vec3 gap = pA - pB;
     const double open = gap.dot(old.c.normal);
     if (open >= drift || (gap - open * old.c.normal).norm() >= drift) continue;
@@ -1100,7 +1185,7 @@ bool World::Impl::keepFinerManifold(PairState& p, const Body& a, const Body& b, 
   double heldDepth = -std::numeric_limits<double>::infinity();  // the previous one's, at most
   for (const SolverContact& old : p.previous) {
     if (!(old.c.errorBound < newBound)) return false;
-    const Vec3 gap = a.x + a.q * old.anchorA - b.x - b.q * old.anchorB;
+    const Vec3 gap = pointOnA(a, old.anchorA, old.c.normal) - pointOnB(b, old.anchorB, old.c.normal);
     const double open = gap.dot(old.c.normal);
     if (open >= drift || (gap - open * old.c.normal).norm() >= drift) return false;
     heldDepth = std::max(heldDepth, -open + old.c.errorBound);
@@ -1248,6 +1333,9 @@ void World::Impl::solve(double h) {
   // normal impulses of the same sweep).
   const double rollingRel = s.rollingResistanceRel;
   auto rollingStep = [&](PairState& p, Body& a, Body& b) {
+    // None where a ball is one side: the lever stands for a non-round body's rocking and a
+    // deforming body's pressure shift, and a ball is a rigid round body (docs/dynamics.md, "Balls").
+    if (a.desc.ballRadius > 0.0 || b.desc.ballRadius > 0.0) return;
     double lambdaN = 0.0;
     for (const SolverContact& cp : p.contacts) lambdaN += cp.lambdaN;
     const double limit = rollingRel * std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal()) * lambdaN;
@@ -1694,7 +1782,7 @@ const StepReport& World::step(double dt) {
       m.report.contactBodies.push_back(ids);
       const Body& a = m.bodies[ids[0]];
       const Body& b = m.bodies[ids[1]];
-      m.report.contactPoints.push_back({a.x + a.q * cp.anchorA, b.x + b.q * cp.anchorB});
+      m.report.contactPoints.push_back({pointOnA(a, cp.anchorA, cp.c.normal), pointOnB(b, cp.anchorB, cp.c.normal)});
     }
   m.endStep();
   return m.report;

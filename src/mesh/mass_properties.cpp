@@ -1,6 +1,7 @@
 #include "clod/mass_properties.h"
 
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include "clod/error.h"
@@ -82,6 +83,16 @@ MassProperties computeMassPropertiesOrBoundingBox(const TriangleMesh& mesh, doub
   mp.inertia(0, 0) = mp.mass / 12.0 * (e.y() * e.y() + e.z() * e.z());
   mp.inertia(1, 1) = mp.mass / 12.0 * (e.x() * e.x() + e.z() * e.z());
   mp.inertia(2, 2) = mp.mass / 12.0 * (e.x() * e.x() + e.y() * e.y());
+  return mp;
+}
+
+MassProperties ballMassProperties(double radius, double density) {
+  if (!(radius > 0.0 && std::isfinite(radius)) || !(density > 0.0 && std::isfinite(density)))
+    throw Error(ErrorCode::kInvalidArgument, "ball radius and density must be > 0 and finite");
+  MassProperties mp;
+  mp.volume = 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
+  mp.mass = density * mp.volume;
+  mp.inertia = Mat3::Identity() * (0.4 * mp.mass * radius * radius);
   return mp;
 }
 

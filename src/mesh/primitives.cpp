@@ -1,5 +1,6 @@
 #include "clod/primitives.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -71,6 +72,24 @@ TriangleMesh makeIcosphere(double radius, std::uint32_t subdivisions) {
     }
     mesh.triangles = std::move(refined);
   }
+  return mesh;
+}
+
+TriangleMesh makeBallHull(double radius, std::uint32_t subdivisions) {
+  requirePositive(radius, "ball radius");
+  // Built at radius 1 and scaled once: a huge radius (1e300) would overflow the planes' normals.
+  TriangleMesh mesh = makeIcosphere(1.0, subdivisions);
+  // The smallest distance of a face's plane from the centre: the faces around the icosahedron's
+  // twelve corners are the most tilted ones.
+  double nearest = 1.0;
+  for (const Triangle& t : mesh.triangles) {
+    const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+    nearest = std::min(nearest, std::abs((b - a).cross(c - a).normalized().dot(a)));
+  }
+  // Rounding of the scaled vertices moves a plane by ~1e-16 of the radius: a hair's margin keeps
+  // every plane at least `radius` away.
+  const double scale = radius * ((1.0 + 1e-12) / nearest);
+  for (Vec3& v : mesh.vertices) v *= scale;
   return mesh;
 }
 

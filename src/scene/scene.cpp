@@ -300,8 +300,9 @@ World buildWorld(const SceneDescription& scene, const std::filesystem::path& cac
       mesh = makeBox(sb.halfExtents);
       source = "box";
     } else {
-      // 2 subdivisions (320 triangles): the polyhedron's volume is within 3.4 % of the ball's.
-      mesh = makeIcosphere(sb.radius, 2);
+      // A polyhedron around the ball (2 subdivisions, 320 triangles); the world puts the contacts
+      // on the ball itself (RigidBodyDesc::ballRadius).
+      mesh = makeBallHull(sb.radius, 2);
       source = "sphere";
     }
     const std::uint64_t hash = meshContentHash(mesh);
@@ -353,7 +354,8 @@ World buildWorld(const SceneDescription& scene, const std::filesystem::path& cac
         ct.maxDepth = sb.bake.contactTreeDepth;
         body->setContactTree(buildContactTree(MeshDistance(mesh), ct));
       }
-      MassProperties mp = computeMassPropertiesOrBoundingBox(mesh);
+      MassProperties mp = sb.shape == SceneShapeKind::kSphere ? ballMassProperties(sb.radius)
+                                                               : computeMassPropertiesOrBoundingBox(mesh);
       rep.bakeSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       found = shapes.emplace(key, std::make_pair(std::shared_ptr<const CollisionBody>(body), mp)).first;
     }
@@ -368,6 +370,7 @@ World buildWorld(const SceneDescription& scene, const std::filesystem::path& cac
       d.inertia = density * mp.inertia;  // computed at density 1: inertia scales linearly
       d.centerOfMass = mp.centerOfMass;
     }
+    if (sb.shape == SceneShapeKind::kSphere) d.ballRadius = sb.radius;
     d.restitution = sb.restitution;
     d.friction = sb.friction;
     d.position = sb.position;
