@@ -3,12 +3,14 @@
 the issue's numbers (docs/benchmarks/degradation.md, "Random drops").
 
 usage: scripts/probe-random-scenes.py SEED KINDS OUTDIR
-  KINDS: comma-separated of stack, tower, pyramid, slide, slope-rest, slope-slide, drop
+  KINDS: comma-separated of stack, tower, pyramid, slide, slope-rest, slope-slide, drop, mass,
+  tumble, spin
   environment: MODELS (cfm,contact-tree,exact), BUDGETS tests per frame (16,64,256,1024,0),
   BUS microseconds per frame (50,200,1000), RATES (240,60), J parallel runs (2),
   CLOD (build/bin/clod), CLOD_MESH_DIR (../shared/data/meshes), SCALE (1: every length times
   SCALE, velocities and times times sqrt(SCALE), so gravity's outcomes scale with the lengths and
-  the judge's thresholds are scaled the same way; issue 21's 1 mm .. 100 m).
+  the judge's thresholds are scaled the same way; issue 21's 1 mm .. 100 m), GROUND (box: a
+  static box; quad, grid: its top face as an open mesh of 2 triangles, or of ~0.5 m squares).
 Prints one FAIL line per run that breaks a criterion of issue 17's point 1 (drops: the lowest
 vertex more than 1 % of the diagonal below the floor top at any frame, or still moving after
 5 s; every scene: a dynamic body's centre inside a static box or under it within its footprint
@@ -36,8 +38,29 @@ def tilt(q0, q):
     # angle between body z axes
     a = rot(q0, [0,0,1]); b = rot(q, [0,0,1])
     d = max(-1,min(1,sum(x*y for x,y in zip(a,b)))); return math.degrees(math.acos(d))
+GROUND = os.environ.get('GROUND', 'box')
+GROUND_DIR = [None]  # set by main: where GROUND's meshes are written
+def ground_mesh(hx, hy, hz):
+    """GROUND=quad: the box's top face as one open quad (2 triangles); GROUND=grid: as a grid of
+    ~0.5 m squares (open, up to 60 x 60). What a user's floor mesh is."""
+    n = 1 if GROUND == 'quad' else max(2, min(60, round(2 * max(hx, hy) / 0.5)))
+    path = os.path.join(GROUND_DIR[0], f"ground_{GROUND}_{hx:.6g}_{hy:.6g}_{hz:.6g}.obj")
+    if not os.path.exists(path):
+        with open(path + '.tmp', 'w') as f:
+            for j in range(n + 1):
+                for i in range(n + 1):
+                    f.write(f"v {-hx + 2 * hx * i / n:.9g} {-hy + 2 * hy * j / n:.9g} {hz:.9g}\n")
+            for j in range(n):
+                for i in range(n):
+                    a = j * (n + 1) + i + 1
+                    f.write(f"f {a} {a + 1} {a + n + 2}\nf {a} {a + n + 2} {a + n + 1}\n")
+        os.replace(path + '.tmp', path)
+    return os.path.abspath(path)
 def ground(hx, hy, mu, pos=(0,0,-0.25), q=None, hz=0.25):
     b = {"name":"ground","box":[hx,hy,hz],"position":list(pos),"static":True,"friction":mu}
+    if GROUND != 'box':
+        # The judge still holds bodies against the box whose top the mesh is ("_box").
+        del b["box"]; b["mesh"] = ground_mesh(hx, hy, hz); b["_box"] = [hx, hy, hz]; b["scale"] = 1.0
     if q: b["orientation"]=q
     return b
 def boxb(name, h, pos, mu, q=None, v=None, extra=None):
@@ -121,13 +144,59 @@ def gen(kind, rng):
         cx=sum(w[0] for w in W)/len(W); cy=sum(w[1] for w in W)/len(W)
         body={"name":"mesh","mesh":os.path.abspath(os.path.join(MESHES, f"{mesh}.obj")),"scale":sc,"position":[-cx,-cy,height-zmin],"orientation":q,"friction":rng.uniform(0.3,0.8)}
         return {"duration":5.0,"bodies":[ground(2,2,0.6),body]}, dict(kind='drop', verts=[[c*sc for c in v] for v in V], diag=want)
+    if kind == 'mass':
+        # A heavy box on a light one (issue 21 point 3: mass ratios up to 1000), judged as a stack.
+        ratio = rng.choice([10, 100, 1000]); mu = rng.uniform(0.4, 0.9)
+        lo = [rng.uniform(0.2, 0.5), rng.uniform(0.2, 0.5), rng.uniform(0.1, 0.4)]
+        hi = [rng.uniform(0.15, 1.0) * lo[0], rng.uniform(0.15, 1.0) * lo[1], rng.uniform(0.1, 0.5)]
+        bodies = [ground(3, 3, mu), boxb("light", lo, [0, 0, lo[2]], mu, extra={"density": 10}),
+                  boxb("heavy", hi, [0, 0, 2 * lo[2] + hi[2]], mu, qz(rng.uniform(0, 90)),
+                       extra={"density": 10 * ratio})]
+        return {"duration": 10.0, "bodies": bodies}, dict(kind='stack', move=0.02, tiltlim=1.0, speed=0.05)
+    if kind in ('tumble', 'spin'):
+        # tumble: a box thrown at the floor turned and spinning, judged as a drop; spin: a box
+        # spinning about the vertical on the floor, which friction stops where it stands.
+        h = [rng.uniform(0.1, 0.5), rng.uniform(0.1, 0.5), rng.uniform(0.05, 0.5)]; mu = rng.uniform(0.3, 0.8)
+        corners = [[sx * h[0], sy * h[1], sz * h[2]] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
+        diag = 2 * math.sqrt(sum(x * x for x in h))
+        if kind == 'spin':
+            w = rng.uniform(2, 12) * rng.choice([-1, 1])
+            body = boxb("box", h, [0, 0, h[2]], mu, qz(rng.uniform(0, 90)), extra={"angular_velocity": [0, 0, w]})
+            return {"duration": 6.0, "bodies": [ground(3, 3, mu), body]}, dict(kind='stack', move=0.05, tiltlim=2.0, speed=0.05)
+        ax = [rng.gauss(0, 1) for _ in range(3)]; n = math.sqrt(sum(a * a for a in ax)); ang = rng.uniform(0, math.pi)
+        q = [math.cos(ang / 2)] + [math.sin(ang / 2) * a / n for a in ax]
+        zmin = min(rot(q, c)[2] for c in corners)
+        body = boxb("box", h, [0, 0, rng.uniform(0.05, 1.0) - zmin], mu, q,
+                    [rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-2, 0)],
+                    extra={"angular_velocity": [rng.uniform(-6, 6) for _ in range(3)]})
+        return {"duration": 6.0, "bodies": [ground(4, 4, mu), body]}, dict(kind='drop', verts=corners, diag=diag)
+    if kind == 'roll':
+        # A ball rolling down a slope without slipping: a = 5/7 g sin(theta) (a solid ball; the
+        # scene's ball is a 320-triangle icosphere, whose facets cost it a little).
+        mu = rng.uniform(0.5, 0.9); th = rng.uniform(4, 20); r = rng.uniform(0.1, 0.5)
+        q = qy(th); n = rot(q, [0, 0, 1]); down = rot(q, [1, 0, 0]); T = 2.0
+        a = 5.0 / 7.0 * G * math.sin(math.radians(th)); HL = max(5.0, a * T * T / 2 + 2)
+        pos = [(0.25 + r) * n[i] - (HL - 1.0) * down[i] for i in range(3)]
+        bodies = [ground(HL, 1.5, mu, (0, 0, 0), q), {"name": "ball", "sphere": r, "position": pos, "friction": mu}]
+        return {"duration": T, "bodies": bodies}, dict(kind='slope-slide', T=T, a=a, down=down)
+    if kind == 'pile':
+        # Boxes dropped turned onto each other and the floor: each comes to rest above the floor.
+        n = rng.randint(3, 6); mu = rng.uniform(0.4, 0.9); bodies = [ground(3, 3, mu)]; z = 0.0
+        for k in range(n):
+            h = [rng.uniform(0.1, 0.3), rng.uniform(0.1, 0.3), rng.uniform(0.05, 0.3)]
+            ax = [rng.gauss(0, 1) for _ in range(3)]; m = math.sqrt(sum(a * a for a in ax)); ang = rng.uniform(0, math.pi)
+            q = [math.cos(ang / 2)] + [math.sin(ang / 2) * a / m for a in ax]
+            rad = math.sqrt(sum(x * x for x in h)); z += rad + 0.02
+            bodies.append(boxb(f"box{k}", h, [rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2), z], mu, q))
+            z += rad
+        return {"duration": 8.0, "bodies": bodies}, dict(kind='pile')
     raise ValueError(kind)
 
 def scaled(scene, info, k):
     """Froude scaling: lengths x k, velocities and times x sqrt(k), angular velocities / sqrt(k)."""
     r = math.sqrt(k)
     for b in scene['bodies']:
-        for key in ('box', 'position'):
+        for key in ('box', '_box', 'position'):
             if key in b: b[key] = [x * k for x in b[key]]
         if 'scale' in b: b['scale'] *= k
         if 'velocity' in b: b['velocity'] = [x * r for x in b['velocity']]
@@ -178,8 +247,8 @@ def judge(traj, info, dt, scene=None):
         if centroid is None: return P(r)
         return [P(r)[i] + rot(Q(r), centroid)[i] for i in range(3)]
     for sb in bodies:
-        if not sb.get('static') or 'box' not in sb: continue
-        c = sb.get('position', [0, 0, 0]); hb = sb['box']; qs = sb.get('orientation', [1, 0, 0, 0])
+        if not sb.get('static') or ('box' not in sb and '_box' not in sb): continue
+        c = sb.get('position', [0, 0, 0]); hb = sb.get('box') or sb['_box']; qs = sb.get('orientation', [1, 0, 0, 0])
         qi = [qs[0], -qs[1], -qs[2], -qs[3]]
         for r in rows:
             if r['body'] in through or r['body'] not in dynamic: continue
@@ -207,6 +276,10 @@ def judge(traj, info, dt, scene=None):
         b=names[0]; p0=P(first[b]); p1=P(last[b]); s=sum((p1[i]-p0[i])*info['down'][i] for i in range(3))
         T=float(last[b]['time']); want=info['a']*T*T/2; err=abs(s-want)
         if abs(s-want)>0.1*want: fails.append(f"slid {s:.3f} vs {want:.3f}")
+    elif info['kind']=='pile':
+        # Every box at rest at the end (the judge above already caught any through the floor).
+        err = max(math.sqrt(sum(x * x for x in V(last[b]))) for b in names)
+        if err > 0.05 * math.sqrt(info.get('length', 1)): fails.append('not at rest %.2f m/s' % err)
     elif info['kind']=='drop':
         b=names[0]; worst=-1e9
         for r in rows:
@@ -222,13 +295,14 @@ def judge(traj, info, dt, scene=None):
 
 def run_one(args):
     sid, scene, info, model, budget, bus, rate, outroot = args
-    sc = dict(scene); sc['dt']=1.0/rate; sc['contact_model']=model; sc['budget']=budget
+    sc = dict(scene); sc['dt']=1.0/rate
+    sc['bodies'] = [{k: v for k, v in b.items() if not k.startswith('_')} for b in scene['bodies']]; sc['contact_model']=model; sc['budget']=budget
     if bus: sc['budget_us']=bus
     d = os.path.join(outroot, f"{sid}_{model}_{budget}_{bus}_{rate}"); os.makedirs(d, exist_ok=True)
     f = os.path.join(d,'scene.json'); json.dump(sc, open(f,'w'))
     r = subprocess.run(['nice', CLOD,'simulate',f,'-o',os.path.join(d,'out')],capture_output=True,text=True,timeout=600)
     if r.returncode!=0: return (sid,model,budget,bus,rate,['exit %d: %s'%(r.returncode,r.stderr.strip()[-200:])],float('nan'))
-    fails, err = judge(os.path.join(d,'out','trajectory.csv'), info, 1.0/rate, sc)
+    fails, err = judge(os.path.join(d,'out','trajectory.csv'), info, 1.0/rate, dict(sc, bodies=scene['bodies']))
     return (sid,model,budget,bus,rate,fails,err)
 
 if __name__=='__main__':
@@ -238,6 +312,7 @@ if __name__=='__main__':
     buss=[float(x) for x in os.environ.get('BUS','50,200,1000').split(',') if x]
     rates=[float(x) for x in os.environ.get('RATES','240,60').split(',')]
     rng=random.Random(seed); jobs=[]
+    os.makedirs(outroot, exist_ok=True); GROUND_DIR[0] = outroot
     for kind in kinds:
         scene, info = scaled(*gen(kind, rng), SCALE); sid=f"{kind}{seed}_{len(jobs)}"
         os.makedirs(outroot, exist_ok=True)

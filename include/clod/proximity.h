@@ -78,6 +78,11 @@ struct MeshDistanceSettings {
   std::uint32_t leafSize = 4;
   /// Force a sign method; by default pseudonormals for closed meshes, winding numbers otherwise.
   bool forceWindingNumber = false;
+  /// Pseudonormals for an open mesh too, where its shared edges are consistently oriented and
+  /// its vertices manifold: behind the surface is inside, as for a sheet (a floor quad, a
+  /// terrain) whose winding number never reaches 1/2 off it. Ignored where those do not hold,
+  /// or with forceWindingNumber.
+  bool sheetPseudonormals = false;
   /// Accuracy of the hierarchical winding number (Barill et al. 2018): a cluster of triangles
   /// is replaced by its second-order far-field expansion when the query point is farther than
   /// windingBeta times the cluster's radius from its centre. The truncation error of a cluster
@@ -153,7 +158,8 @@ public:
   /// Baerentzen & Aanaes 2005). The index must be in range (CLOD_ASSERT). O(1).
   Vec3 featureNormal(MeshFeature feature) const;
 
-  /// kPseudonormal iff the mesh is closed (every edge has exactly two triangles), consistently
+  /// kPseudonormal iff the mesh is closed (every edge has exactly two triangles; or, with
+  /// settings.sheetPseudonormals, at most two), consistently
   /// oriented (the two triangles of every edge traverse it in opposite directions), every
   /// vertex is manifold (its triangles form one fan: two cones touching at a vertex break the
   /// pseudonormal argument there) and settings.forceWindingNumber is false; otherwise

@@ -88,7 +88,12 @@ constexpr std::size_t kChunkCells = 1u << 16;
 
 class Builder {
 public:
-  Builder(const MeshDistance& distance, const ContactTreeSettings& settings) : distance_(distance), settings_(settings) {}
+  // `inferSigns`: the sign inference holds for a field continuous across space (a closed mesh's,
+  // or a winding number's away from its membranes); a sheet's pseudonormal sign jumps across
+  // the plane beyond its border, and a corner below it there "proved" points above the floor
+  // inside (a box 0.669 above a two-triangle floor read -0.669).
+  Builder(const MeshDistance& distance, const ContactTreeSettings& settings, bool inferSigns = true)
+      : distance_(distance), settings_(settings), inferSigns_(inferSigns) {}
 
   ContactTree build(ContactTreeBuildStats* stats);
 
@@ -111,6 +116,7 @@ private:
 
   const MeshDistance& distance_;
   const ContactTreeSettings& settings_;
+  bool inferSigns_;
   ContactTree tree_;
   std::vector<double> exactScratch_;
   std::vector<LatticeRequest> requests_;
@@ -137,6 +143,7 @@ int Builder::inferSign(const PendingCell& cell, std::uint32_t depth, const Vec3&
   // The sign is the expensive part of an exact query for open meshes (a winding number), and
   // often it is already known: if a corner value v has |v| > |x - corner|, d(x) has v's sign,
   // since |d(x) - v| <= |x - corner|. Then only the unsigned distance is needed.
+  if (!inferSigns_) return 0;
   const double h = tree_.cellSize(depth);
   for (int c = 0; c < 8; ++c) {
     const double reach = h * (t - Vec3(c & 1, (c >> 1) & 1, (c >> 2) & 1)).norm();
@@ -401,10 +408,41 @@ ContactTree Builder::build(ContactTreeBuildStats* stats) {
   return std::move(tree_);
 }
 
+// An open mesh that encloses nothing: a sheet (a floor quad, a terrain). Just behind its faces
+// the winding number stays near 1/2 (the sheet's own half of the solid angle), where behind a
+// closed mesh's faces, or one with holes (stanford-bunny), or an open box, it is near 1 (0.8 for
+// the box: its missing face's share). Judged on up to 256 faces spread over the mesh, each
+// probed 1e-4 of the diagonal behind its centroid: a sheet when fewer than 1 in 10 reach 3/4.
+bool enclosesNothing(const MeshDistance& distance) {
+  const TriangleMesh& mesh = distance.mesh();
+  const std::uint32_t count = mesh.triangleCount();
+  const std::uint32_t stride = std::max<std::uint32_t>(1, count / 256);
+  const double behind = 1e-4 * mesh.bounds().diagonal();
+  std::uint32_t probed = 0, enclosed = 0;
+  for (std::uint32_t t = 0; t < count; t += stride) {
+    const Vec3 a = mesh.corner(t, 0), b = mesh.corner(t, 1), c = mesh.corner(t, 2);
+    const Vec3 n = (b - a).cross(c - a);
+    if (!(n.norm() > 0.0)) continue;
+    ++probed;
+    if (distance.windingNumber((a + b + c) / 3.0 - behind * n.normalized()) >= 0.75) ++enclosed;
+  }
+  return probed > 0 && enclosed * 10 < probed;
+}
+
 }  // namespace
 
 ContactTree buildContactTree(const MeshDistance& distance, const ContactTreeSettings& settings, ContactTreeBuildStats* stats) {
   checkSettings(settings);
+  // A sheet's winding number never reaches 1/2 off it: signed by it, the field is a distance
+  // without an inside, and a box sliding on a two-triangle floor sank through it. Signed by its
+  // pseudonormals, behind the sheet is inside (docs/contact-tree.md, "Sheets").
+  if (distance.signMethod() == SignMethod::kWindingNumber && enclosesNothing(distance)) {
+    const MeshDistance sheet(distance.mesh(), MeshDistanceSettings{.sheetPseudonormals = true});
+    if (sheet.signMethod() == SignMethod::kPseudonormal) {
+      Builder builder(sheet, settings, /*inferSigns=*/false);
+      return builder.build(stats);
+    }
+  }
   // A soup of overlapping parts has walls inside its solid: the field is the distance to the
   // solid's boundary (solid_boundary.h), and a wall's -|d| kink would be refined to the tree's
   // depth on both sides. One closed manifold part has no walls.

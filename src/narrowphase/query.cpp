@@ -1355,15 +1355,17 @@ bool vertexOnFaceContacts(const PatchSide& patch, const PatchSide& faceted, cons
   return out.size() > before;
 }
 
-// A convex patch's corners behind a flat patch (all its triangles in one plane) of a non-convex
-// body, each over one of that patch's triangles: the plane is the surface there, so a corner's
-// depth below it is its exact penetration, along the plane's normal (error bound 0). A flat piece
+// A patch's bounding vertices (a faceted patch's corners, a curved patch's support vertices: its
+// hull, which holds its deepest points along any direction) behind a flat patch (all its
+// triangles in one plane) of an open non-convex body, each over one of that patch's triangles:
+// the plane is the surface there, so a vertex's depth below it is its exact penetration, along
+// the plane's normal (error bound 0). A flat piece
 // of a floor with more vertices than a faceted patch keeps counted as a curved patch, bounded by
 // its sphere: a box resting on one bottom edge, 1 mm into the floor, got contacts along the
 // floor's normal at the floor sphere's centre and across the box's underside, 0.2-0.3 m from the
 // edge, with the spheres' error bound; their friction turned the box the wrong way over the
 // flat-contact bump (docs/narrow-phase.md, "Flat patches"). Returns false when it added nothing.
-bool cornersOverFlatPatchContacts(const PatchSide& flat, const PatchSide& convex, bool flatIsB, const Contact& c,
+bool cornersOverFlatPatchContacts(const PatchSide& flat, const PatchSide& other, bool flatIsB, const Contact& c,
                                   std::vector<Contact>& out) {
   const Vec3 nLocal = flat.body.sphereFaceNormals(flat.sphere)[0].cast<double>();
   const Vec3 n = flat.rotToA ? Vec3(*flat.rotToA * nLocal) : nLocal;  // outward, A frame
@@ -1371,10 +1373,10 @@ bool cornersOverFlatPatchContacts(const PatchSide& flat, const PatchSide& convex
   const std::span<const std::uint32_t> triangles = flat.body.sphereTree().triangles(flat.sphere);
   if (triangles.empty()) return false;
   const double offsetLocal = nLocal.dot(mesh.corner(triangles[0], 0));
-  const double tolerance = 1e-9 * (flat.body.diagonal() + convex.body.diagonal());
+  const double tolerance = 1e-9 * (flat.body.diagonal() + other.body.diagonal());
   const std::size_t before = out.size();
-  for (std::uint32_t id : convex.body.spherePatchVertices(convex.sphere)) {
-    const Vec3 v = convex.toA(convex.body.mesh().vertices[id]);
+  for (std::uint32_t id : other.boundingVertices()) {
+    const Vec3 v = other.toA(other.body.mesh().vertices[id]);
     const Vec3 vLocal = flat.rotToA ? Vec3(flat.rotToA->transpose() * (v - flat.shift)) : v;  // flat body's frame
     const double depth = offsetLocal - nLocal.dot(vLocal);
     if (!(depth > tolerance)) continue;
@@ -1637,20 +1639,24 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
       s.edgeContacts.push_back(c);
       continue;
     } else {
-      // A flat patch of an open non-convex body (a ground quad) against a convex patch: the convex
-      // corners over it and its own vertices inside the convex body are the whole contact; none of
-      // either means the convex body's underside does not reach into this piece (an edge lying
-      // across it is held by the corners over the neighbouring pieces).
-      const bool flatA = !convexA && sideB.faceted && convexB && bodyA.sphereFaceNormals(p.a).size() == 1;
-      const bool flatB = !flatA && !convexB && sideA.faceted && convexA && bodyB.sphereFaceNormals(p.b).size() == 1;
+      // A flat patch of an open body (a ground quad) against any patch: the other patch's
+      // bounding vertices over it (its hull's, which hold its deepest points) and, for a convex
+      // faceted patch, the flat patch's own vertices inside the convex body are the whole contact;
+      // none of either means the other side's underside does not reach into this piece (an edge
+      // lying across it is held by the corners over the neighbouring pieces). A closed spot on a
+      // two-triangle floor got one contact at the roots' spheres (16-64 tests per frame) and
+      // rocked about it, 18 % of its size into the floor; at full depth its leaves' cfm normals
+      // below the plane pointed down, through it.
+      const bool flatA = !convexA && !bodyA.isClosed() && bodyA.sphereFaceNormals(p.a).size() == 1;
+      const bool flatB = !flatA && !convexB && !bodyB.isClosed() && bodyB.sphereFaceNormals(p.b).size() == 1;
       if (flatA) {
         cornersOverFlatPatchContacts(sideA, sideB, false, c, out);
-        vertexOnFaceContacts(sideA, sideB, c.normal, c, out);
+        if (sideB.faceted && convexB) vertexOnFaceContacts(sideA, sideB, c.normal, c, out);
         continue;
       }
       if (flatB) {
         cornersOverFlatPatchContacts(sideB, sideA, true, c, out);
-        vertexOnFaceContacts(sideB, sideA, -c.normal, c, out);
+        if (sideA.faceted && convexA) vertexOnFaceContacts(sideB, sideA, -c.normal, c, out);
         continue;
       }
       if ((!sideA.faceted || !convexA) && sideB.faceted && convexB && vertexOnFaceContacts(sideA, sideB, c.normal, c, out))
@@ -2130,7 +2136,7 @@ void vertexContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, cons
   auto trySide = [&](const QueryScratch::Impl::VolumePair& pair, bool sideA) {
     const CollisionBody& self = sideA ? bodyA : bodyB;
     const CollisionBody& other = sideA ? bodyB : bodyA;
-    if (!other.isClosed()) return;
+    if (!other.isClosed() && !self.isClosed()) return;
     const TriangleMesh& mesh = self.mesh();
     const TriangleMesh& otherMesh = other.mesh();
     const MatrixPose& aFromSelf = sideA ? identity : aFromB;

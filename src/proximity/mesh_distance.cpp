@@ -54,8 +54,11 @@ void validate(const TriangleMesh& mesh) {
 }
 
 // True when every edge's two triangles traverse it in opposite directions.
-bool consistentlyOriented(const TriangleMesh& mesh, const MeshTopology& topology) {
+// Every edge's two triangles traverse it in opposite directions; with `borders`, an edge of one
+// triangle (an open mesh's border) passes too.
+bool consistentlyOriented(const TriangleMesh& mesh, const MeshTopology& topology, bool borders = false) {
   for (std::uint32_t e = 0; e < topology.edgeCount(); ++e) {
+    if (borders && topology.edgeTriangles(e).size() == 1) continue;
     int forward = 0, backward = 0;
     for (std::uint32_t t : topology.edgeTriangles(e)) {
       for (int k = 0; k < 3; ++k) {
@@ -344,7 +347,8 @@ MeshDistance::MeshDistance(TriangleMesh mesh, const MeshDistanceSettings& settin
   impl.buildFarFields(settings.windingBeta);
 
   const bool pseudonormalsValid =
-      impl.topology->closed() && consistentlyOriented(m, *impl.topology) && verticesManifold(m, *impl.topology);
+      (impl.topology->closed() || settings.sheetPseudonormals) &&
+      consistentlyOriented(m, *impl.topology, settings.sheetPseudonormals) && verticesManifold(m, *impl.topology);
   impl.signMethod = pseudonormalsValid && !settings.forceWindingNumber ? SignMethod::kPseudonormal
                                                                        : SignMethod::kWindingNumber;
 }

@@ -497,3 +497,33 @@ TEST(MeshDistanceSettingsCheck, EveryLeafSizeGivesTheSameDistances) {
 }
 
 }  // namespace
+
+namespace clod {
+namespace {
+
+// A sheet (an open mesh that encloses nothing: a floor quad, a terrain) signed by its
+// pseudonormals with MeshDistanceSettings::sheetPseudonormals: behind it is inside. Oracle: the
+// analytic distance to the plane over the footprint, signed by the side. Long thin triangles (a
+// 13.7 x 3 m quad in two) included: a box on such a floor read -0.669 at 0.669 above it.
+TEST(MeshDistanceSheet, QuadIsSignedByItsSideOverItsFootprint) {
+  for (double hx : {1.0, 6.86}) {
+    TriangleMesh quad;
+    const double hy = 1.5, z = 0.25;
+    quad.vertices = {Vec3(-hx, -hy, z), Vec3(hx, -hy, z), Vec3(-hx, hy, z), Vec3(hx, hy, z)};
+    quad.triangles = {{0, 1, 3}, {0, 3, 2}};
+    const MeshDistance winding(quad);
+    EXPECT_EQ(winding.signMethod(), SignMethod::kWindingNumber);
+    const MeshDistance sheet(quad, MeshDistanceSettings{.sheetPseudonormals = true});
+    ASSERT_EQ(sheet.signMethod(), SignMethod::kPseudonormal);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-0.95, 0.95), h(-1.0, 1.0);
+    for (int i = 0; i < 2000; ++i) {
+      const Vec3 p(u(rng) * hx, u(rng) * hy, z + h(rng));
+      // 1e-12 of the quad's size: rounding of the closest point.
+      EXPECT_NEAR(sheet.signedDistance(p), p.z() - z, 1e-12 * hx) << p.transpose();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace clod
