@@ -199,6 +199,7 @@ def scaled(scene, info, k):
         for key in ('box', '_box', 'position'):
             if key in b: b[key] = [x * k for x in b[key]]
         if 'scale' in b: b['scale'] *= k
+        if 'sphere' in b: b['sphere'] *= k
         if 'velocity' in b: b['velocity'] = [x * r for x in b['velocity']]
         if 'angular_velocity' in b: b['angular_velocity'] = [x / r for x in b['angular_velocity']]
     scene['duration'] *= r

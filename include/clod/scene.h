@@ -18,7 +18,8 @@
 // "mesh_limits" {"max_vertices", "max_triangles", "max_polygon_vertices"} (MeshLoadOptions's
 // resource limits for every mesh file of the scene, defaults as there),
 // "bounds" {"min": [..], "max": [..]}, "bodies" [ ... ]. Body keys: "name", exactly one of
-// "mesh" (path relative to the scene file), "box" [hx,hy,hz] (half extents) or "sphere" r;
+// "mesh" (path relative to the scene file), "box" [hx,hy,hz] (half extents) or "sphere" r (a
+// ball: RigidBodyDesc::ballRadius, its mesh makeBallHull's, the solid ball's mass properties);
 // "position", "orientation" [w,x,y,z] (any finite, nonzero magnitude: normalised), "velocity",
 // "angular_velocity", "torque" [x,y,z] (N m,
 // world frame, constant: applyConstantTorques hands it to World::applyTorque before every step),
