@@ -8,6 +8,7 @@
 #include "clod/contact_tree.h"
 #include "clod/contact_tree_builder.h"
 #include "clod/proximity.h"
+#include "support/floor_quad.h"
 #include "support/test_scale.h"
 
 namespace clod {
@@ -19,9 +20,7 @@ namespace {
 // inference across the plane beyond the border, points 0.67 above the floor read -0.67.
 TEST(ContactTreeSheet, FloorQuadIsSignedByItsSideOverItsFootprint) {
   const double hx = 6.86, hy = 1.5, z = 0.25;
-  TriangleMesh quad;
-  quad.vertices = {Vec3(-hx, -hy, z), Vec3(hx, -hy, z), Vec3(-hx, hy, z), Vec3(hx, hy, z)};
-  quad.triangles = {{0, 1, 3}, {0, 3, 2}};
+  const TriangleMesh quad = test::makeFloorQuad(hx, hy, z);
   ContactTreeSettings settings;
   if (test::sanitizerRun()) settings.errorRel = 4e-3;  // the checks hold against the tree's own bound
   const ContactTree tree = buildContactTree(MeshDistance(quad), settings);

@@ -10,6 +10,7 @@
 #include "clod/mass_properties.h"
 #include "clod/primitives.h"
 #include "clod/world.h"
+#include "support/floor_quad.h"
 #include "support/l_shaped_body.h"
 #include "support/test_scale.h"
 #include "world_test_support.h"
@@ -17,20 +18,13 @@
 namespace clod {
 namespace {
 
-TriangleMesh floorQuad() {
-  TriangleMesh quad;
-  quad.vertices = {Vec3(-4, -2, 0), Vec3(4, -2, 0), Vec3(-4, 2, 0), Vec3(4, 2, 0)};
-  quad.triangles = {{0, 1, 3}, {0, 3, 2}};
-  return quad;
-}
-
 // A box thrown turned and spinning at the floor, and the closed non-convex L (tests/support),
 // turned, dropped on it: issue 17's drop criteria, the lowest vertex never more than 1 % of the
 // body's diagonal under the floor at any frame, and at rest (< 5 cm/s) after 4 s. Before, the
 // contact tree's field of the quad had no inside (its winding number never reaches 1/2) and the
 // box fell through; cfm and exact let a closed non-convex body sink 6-30 % into it.
 TEST(SheetFloor, BodiesDroppedOnATwoTriangleFloorComeToRestOnItWithEveryModel) {
-  const auto floor = test::bakeWorldShape(floorQuad());
+  const auto floor = test::bakeWorldShape(test::makeFloorQuad(4.0, 2.0));
   const TriangleMesh meshes[] = {makeBox(Vec3(0.3, 0.15, 0.25)), test::makeLShapedBody()};
   const double scales[] = {1.0, 0.15};
   const bool sanitized = test::sanitizerRun();

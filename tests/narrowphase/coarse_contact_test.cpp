@@ -18,6 +18,7 @@
 #include "clod/contact_tree_builder.h"
 #include "clod/mesh_io.h"
 #include "clod/primitives.h"
+#include "support/floor_quad.h"
 #include "support/grid_box.h"
 #include "support/l_shaped_body.h"
 #include "support/test_scale.h"
@@ -660,16 +661,8 @@ TEST(CoarseContacts, BoxOnTheFloorOfAnLShapedBodyIsHeldUpByItsCornersAtEveryBudg
   }
 }
 
-// A floor made of one open quad (two long triangles, 8 x 4 m): what a user's ground mesh is.
-TriangleMesh twoTriangleFloor() {
-  TriangleMesh quad;
-  quad.vertices = {Vec3(-4, -2, 0), Vec3(4, -2, 0), Vec3(-4, 2, 0), Vec3(4, 2, 0)};
-  quad.triangles = {{0, 1, 3}, {0, 3, 2}};
-  return quad;
-}
-
 // A closed non-convex body (the L, turned 20 deg about x and 10 deg about y) and a box, turned
-// onto a corner, sunk 1 cm into a two-triangle floor. Oracle: the floor is the plane z = 0, so
+// onto a corner, sunk 1 cm into a two-triangle floor (8 x 4 m: what a user's ground mesh is). Oracle: the floor is the plane z = 0, so
 // each vertex's depth is -z, and the deepest vertex is the penetration. Every contact of cfm (and
 // of exact: its cfm fallback below 64 tests, its triangle-level answer unlimited) pushes the body
 // up, none is deeper than the deepest vertex, and the deepest contact is it. Before, the L got one
@@ -677,7 +670,7 @@ TriangleMesh twoTriangleFloor() {
 // down, through the floor (a spot on such a floor sank 18 % of its size); the exact model ignored
 // vertices behind an open body's triangles and hung a box from the floor's vertices, 23 cm under.
 TEST(CoarseContacts, BodiesSunkIntoATwoTriangleFloorArePushedUpFromTheirDeepestVertex) {
-  static const CollisionBody floor = octreeBodyForCfm(twoTriangleFloor());
+  static const CollisionBody floor = octreeBodyForCfm(test::makeFloorQuad(4.0, 2.0));
   ASSERT_FALSE(floor.isClosed());
   const Quat turn = Quat(Eigen::AngleAxisd(20.0 * M_PI / 180.0, Vec3::UnitX())) *
                     Quat(Eigen::AngleAxisd(10.0 * M_PI / 180.0, Vec3::UnitY()));

@@ -18,6 +18,7 @@
 #include "clod/primitives.h"
 #include "clod/proximity.h"
 #include "oracle.h"
+#include "support/floor_quad.h"
 
 namespace {
 
@@ -507,10 +508,8 @@ namespace {
 // 13.7 x 3 m quad in two) included: a box on such a floor read -0.669 at 0.669 above it.
 TEST(MeshDistanceSheet, QuadIsSignedByItsSideOverItsFootprint) {
   for (double hx : {1.0, 6.86}) {
-    TriangleMesh quad;
     const double hy = 1.5, z = 0.25;
-    quad.vertices = {Vec3(-hx, -hy, z), Vec3(hx, -hy, z), Vec3(-hx, hy, z), Vec3(hx, hy, z)};
-    quad.triangles = {{0, 1, 3}, {0, 3, 2}};
+    const TriangleMesh quad = test::makeFloorQuad(hx, hy, z);
     const MeshDistance winding(quad);
     EXPECT_EQ(winding.signMethod(), SignMethod::kWindingNumber);
     const MeshDistance sheet(quad, MeshDistanceSettings{.sheetPseudonormals = true});
