@@ -974,6 +974,12 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       // first stops the approach (compression impulse), then adds restitution x that impulse
       // (Stronge, "Impact Mechanics", 2000). Decided once, from the pre-solve approach speed.
       cp.restitution = vn < -s.restitutionThreshold ? restitution : 0.0;
+      // A speculative contact (still open) that closes within this substep and bounces is
+      // stopped now, up to its gap early, so that the whole approach bounces: the solve would
+      // only slow it to what closes the gap, and the bodies met at that speed in the next
+      // substep, below the bounce threshold -- a ball (whose hull meets the floor before the ball
+      // does, docs/dynamics.md "Balls") dropped with restitution 0.5 did not bounce at all.
+      if (cp.restitution > 0.0 && cp.separation > 0.0 && cp.separation + vn * h < 0.0) cp.speculative = 0.0;
       // Only the part of the depth that is certain is corrected, the same way for every model:
       // a contact's depth may be off by its errorBound (a coarse sphere pair's surfaces lie
       // somewhere inside both spheres), so correcting that part would push apart bodies that do
