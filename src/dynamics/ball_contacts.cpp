@@ -13,19 +13,35 @@ constexpr double kSameNormalCos = 0.9986;
 
 }  // namespace
 
-Contact ballBallContact(const Vec3& centreA, double radiusA, const Vec3& centreB, double radiusB, double& gap) {
+void ballBallAnswer(const Vec3& centreA, double radiusA, const Vec3& centreB, double radiusB, QueryResult& result) {
   const Vec3 d = centreA - centreB;
   const double distance = d.norm();
+  const double gap = distance - radiusA - radiusB;
+  result.contacts.clear();
+  result.frontier.clear();
+  result.intersectingTriangles.clear();
+  result.tests = result.sphereTests = 1;
+  result.triangleTests = 0;
+  result.finished = true;
+  result.stop = QueryStop::kFinished;
+  result.minLevel = result.maxLevel = 0;
+  result.pairsAnswered = 0;
+  result.fallbackPairs = 0;
+  result.fallbackModel = ContactModel::kExact;
+  result.separation = std::max(gap, 0.0);
+  result.seconds = 0.0;
+  result.colliding = gap <= 0.0;
+  result.rawContacts = result.colliding ? 1 : 0;
+  if (!result.colliding) return;
   Contact c;
   c.normal = distance > 0.0 ? Vec3(d / distance) : Vec3::UnitZ();
-  gap = distance - radiusA - radiusB;
   c.depth = -gap;
   // Midway between A's deepest point (its surface toward B) and B's (its surface toward A).
   c.point = 0.5 * ((centreA - radiusA * c.normal) + (centreB + radiusB * c.normal));
   c.errorBound = 0.0;
   c.featureA = c.featureB = 0;  // the root spheres: the balls themselves
   c.featureKind = ContactFeature::kSphere;
-  return c;
+  result.contacts.push_back(c);
 }
 
 std::uint32_t putContactsOnBall(std::vector<Contact>& contacts, const Vec3& centre, double radius, bool ballIsA,

@@ -9,14 +9,16 @@
 #include "clod/collision_body.h"
 #include "clod/contact.h"
 #include "clod/math.h"
+#include "clod/query.h"
 #include "narrowphase/containment.h"
 
 namespace clod::detail {
 
-/// Two balls A and B (centres, radii): the one contact along the centre line, normal from B's
-/// centre toward A's (+z where the centres coincide), point midway through the overlap, error
-/// bound 0; `gap` gets the distance between the surfaces (negative when they overlap).
-Contact ballBallContact(const Vec3& centreA, double radiusA, const Vec3& centreB, double radiusB, double& gap);
+/// Two balls A and B (centres, radii) as a finished query's answer: one test; where they touch,
+/// the one contact along the centre line, normal from B's centre toward A's (+z where the
+/// centres coincide), point midway through the overlap, error bound 0; where they do not, no
+/// contact and `separation` the gap between the surfaces.
+void ballBallAnswer(const Vec3& centreA, double radiusA, const Vec3& centreB, double radiusB, QueryResult& result);
 
 /// Puts the ball's side of a query's contacts on the ball. Each contact's point on the other body
 /// (contactPointOnA/B) is a seed: the other body's exact field there (exactBodyFieldWithin, within

@@ -629,35 +629,61 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       continue;
     }
     pr.provenApart = false;
-    if (a.desc.ballRadius > 0.0 && bb.desc.ballRadius > 0.0) {
-      // Two balls: one exact contact, one test (docs/dynamics.md, "Balls").
-      double gap = 0.0;
-      const Contact c = detail::ballBallContact(a.pose().translation, a.desc.ballRadius, bb.pose().translation,
-                                                bb.desc.ballRadius, gap);
-      const std::uint64_t cost = limited ? std::min<std::uint64_t>(remaining, 1) : 1;
+    // What a pair's answer (`result`) leaves: its budget charged, the report, the pair's state
+    // and its new contacts (the persistent manifold merges them below).
+    auto recordAnswer = [&](std::uint64_t offeredShare) {
+      // WorldSettings::maxCachedNodePairs: a new cache, not clear(), which would keep the memory.
+      if (p->cache.frontSize() > cacheShare) p->cache = CoherenceCache();
+      // Charged as far as the substep has it left (only the roots' answer above may cost more).
+      const std::uint64_t fullCost = result.tests + perCell * result.frontier.size();
+      const std::uint64_t cost = limited ? std::min(remaining, fullCost) : fullCost;
+      report.unitsWorked += fullCost;
       remaining -= cost;
       report.budgetSpent += cost;
-      ++report.testsSpent;
-      ++report.unitsWorked;
-      pr.tests += 1;
-      pr.level = 0;
-      pr.finished = true;
-      pr.fallbackPairs = 0;
-      pr.skipped = pr.reused = false;
-      p->interrupted = false;
-      p->reusable = false;
-      p->apartBy = std::max(gap, 0.0);
+      report.testsSpent += result.tests;
+      report.frontierPairs += result.frontier.size();
+      report.rawContacts += result.rawContacts;
+      pr.tests += result.tests;
+      pr.level = result.maxLevel;
+      pr.finished = result.finished;
+      pr.fallbackPairs = result.fallbackPairs;
+      report.fallbackPairs += result.fallbackPairs;
+      pr.skipped = false;
+      pr.reused = false;
+      if (!result.finished) ++report.pairsInterrupted;
+      p->interrupted = !result.finished;
+      // Only a finished answer with contacts is reused: an empty one says nothing about how near
+      // the bodies are, and a new contact region could open within any motion.
+      p->reusable = result.finished && !result.contacts.empty() && s.reuseMotionRel > 0.0;
+      p->apartBy = result.separation;
       p->queriedAt = a.pose().inverse() * bb.pose();
+      p->share = offeredShare;
       p->keptFiner = false;
       p->stale = 0;
       p->fresh = true;
       p->previous.swap(p->contacts);
       p->contacts.clear();
-      if (gap <= 0.0) {
+      if ((a.desc.ballRadius > 0.0) != (bb.desc.ballRadius > 0.0)) {
+        // A ball's contacts are the ball's, not its polyhedron's (docs/dynamics.md, "Balls").
+        const bool ballIsA = a.desc.ballRadius > 0.0;
+        const Body& ball = ballIsA ? a : bb;
+        const Body& other = ballIsA ? bb : a;
+        const std::uint32_t fieldQueries = detail::putContactsOnBall(
+            result.contacts, ball.pose().translation, ball.desc.ballRadius, ballIsA, *other.desc.shape, other.pose(), ballScratch);
+        report.testsSpent += fieldQueries;
+        report.unitsWorked += fieldQueries;
+        pr.tests += fieldQueries;
+      }
+      for (const Contact& c : result.contacts) {
         SolverContact cp;
         cp.c = c;
         p->contacts.push_back(cp);
       }
+    };
+    if (a.desc.ballRadius > 0.0 && bb.desc.ballRadius > 0.0) {
+      // Two balls: one exact contact, one test, no query (docs/dynamics.md, "Balls").
+      detail::ballBallAnswer(a.pose().translation, a.desc.ballRadius, bb.pose().translation, bb.desc.ballRadius, result);
+      recordAnswer(0);
       --left;
       continue;
     }
@@ -821,53 +847,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       qs.model = s.model;
       p->cache.clear();  // a sphere front; the next contact-tree query starts from the roots
     }
-    // WorldSettings::maxCachedNodePairs: a new cache, not clear(), which would keep the memory.
-    if (p->cache.frontSize() > cacheShare) p->cache = CoherenceCache();
-    // Charged as far as the substep has it left (only the roots' answer above may cost more).
-    const std::uint64_t fullCost = result.tests + perCell * result.frontier.size();
-    const std::uint64_t cost = limited ? std::min(remaining, fullCost) : fullCost;
-    report.unitsWorked += fullCost;
-    remaining -= cost;
-    report.budgetSpent += cost;
-    report.testsSpent += result.tests;
-    report.frontierPairs += result.frontier.size();
-    report.rawContacts += result.rawContacts;
-    pr.tests += result.tests;
-    pr.level = result.maxLevel;
-    pr.finished = result.finished;
-    pr.fallbackPairs = result.fallbackPairs;
-    report.fallbackPairs += result.fallbackPairs;
-    pr.skipped = false;
-    pr.reused = false;
-    if (!result.finished) ++report.pairsInterrupted;
-    p->interrupted = !result.finished;
-    // Only a finished answer with contacts is reused: an empty one says nothing about how near
-    // the bodies are, and a new contact region could open within any motion.
-    p->reusable = result.finished && !result.contacts.empty() && s.reuseMotionRel > 0.0;
-    p->apartBy = result.separation;
-    p->queriedAt = a.pose().inverse() * bb.pose();
-    p->share = offered;
-    p->keptFiner = false;
-    p->stale = 0;
-    p->fresh = true;
-    p->previous.swap(p->contacts);
-    p->contacts.clear();
-    if (a.desc.ballRadius > 0.0 || bb.desc.ballRadius > 0.0) {
-      // A ball's contacts are the ball's, not its polyhedron's (docs/dynamics.md, "Balls").
-      const bool ballIsA = a.desc.ballRadius > 0.0;
-      const Body& ball = ballIsA ? a : bb;
-      const Body& other = ballIsA ? bb : a;
-      const std::uint32_t fieldQueries = detail::putContactsOnBall(result.contacts, ball.pose().translation, ball.desc.ballRadius,
-                                                                   ballIsA, *other.desc.shape, other.pose(), ballScratch);
-      report.testsSpent += fieldQueries;
-      report.unitsWorked += fieldQueries;
-      pr.tests += fieldQueries;
-    }
-    for (const Contact& c : result.contacts) {
-      SolverContact cp;
-      cp.c = c;
-      p->contacts.push_back(cp);
-    }
+    recordAnswer(offered);
   }
   report.narrowPhaseSeconds += since(t0);
   if (timed) report.timeSpentMicros += std::chrono::duration<double, std::micro>(s.clock() - tTimed).count();

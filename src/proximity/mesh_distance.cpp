@@ -53,7 +53,6 @@ void validate(const TriangleMesh& mesh) {
   if (!anyArea) throw Error(ErrorCode::kAllTrianglesDegenerate, "every triangle of the mesh has zero area");
 }
 
-// True when every edge's two triangles traverse it in opposite directions.
 // Every edge's two triangles traverse it in opposite directions; with `borders`, an edge of one
 // triangle (an open mesh's border) passes too.
 bool consistentlyOriented(const TriangleMesh& mesh, const MeshTopology& topology, bool borders = false) {
