@@ -78,7 +78,9 @@ std::optional<std::string> findBadObjIndex(std::string_view text) {
 
 bool looksLikePly(std::string_view text) {
   std::size_t i = 0;
-  while (i < text.size() && (text[i] == ' ' || text[i] == '\t' || text[i] == '\r' || text[i] == '\n')) ++i;
+  // Assimp drops NUL bytes before it looks for the "ply" token: "\0\nply" without an end_header
+  // hung its PLY reader (a fuzz finding).
+  while (i < text.size() && (text[i] == ' ' || text[i] == '\t' || text[i] == '\r' || text[i] == '\n' || text[i] == '\0')) ++i;
   if (text.size() - i < 3) return false;
   auto lower = [](char c) { return c >= 'A' && c <= 'Z' ? char(c - 'A' + 'a') : c; };
   return lower(text[i]) == 'p' && lower(text[i + 1]) == 'l' && lower(text[i + 2]) == 'y';

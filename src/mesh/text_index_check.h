@@ -21,7 +21,8 @@ namespace clod::detail {
 /// vertex, or 0), as a message naming the line; nullopt when none. O(size).
 std::optional<std::string> findBadObjIndex(std::string_view text);
 
-/// True when the bytes start (after whitespace) with the PLY magic "ply", case-insensitive:
+/// True when the bytes start (after whitespace and NUL bytes, which Assimp drops) with the PLY
+/// magic "ply", case-insensitive:
 /// Assimp hands such content to its PLY reader whatever the extension says.
 bool looksLikePly(std::string_view text);
 
