@@ -4,13 +4,16 @@ the issue's numbers (docs/benchmarks/degradation.md, "Random drops").
 
 usage: scripts/probe-random-scenes.py SEED KINDS OUTDIR
   KINDS: comma-separated of stack, tower, pyramid, slide, slope-rest, slope-slide, drop, mass,
-  tumble, spin
+  tumble, spin, roll, pile, overhang
   environment: MODELS (cfm,contact-tree,exact), BUDGETS tests per frame (16,64,256,1024,0),
   BUS microseconds per frame (50,200,1000), RATES (240,60), J parallel runs (2),
   CLOD (build/bin/clod), CLOD_MESH_DIR (../shared/data/meshes), SCALE (1: every length times
   SCALE, velocities and times times sqrt(SCALE), so gravity's outcomes scale with the lengths and
   the judge's thresholds are scaled the same way; issue 21's 1 mm .. 100 m), GROUND (box: a
-  static box; quad, grid: its top face as an open mesh of 2 triangles, or of ~0.5 m squares).
+  static box; quad, grid: its top face as an open mesh of 2 triangles, or of ~0.5 m squares;
+  step: the box as a closed non-convex mesh with a wall on its +x end),
+  BOXES (box: primitives; obj: each dynamic box a closed 12-triangle OBJ; tessN: its faces cut
+  into N x N squares), DROPS (the meshes a drop picks from: bunny-1500,spot,fandisk).
 Prints one FAIL line per run that breaks a criterion of issue 17's point 1 (drops: the lowest
 vertex more than 1 % of the diagonal below the floor top at any frame, or still moving after
 5 s; every scene: a dynamic body's centre inside a static box or under it within its footprint
@@ -56,15 +59,67 @@ def ground_mesh(hx, hy, hz):
                     f.write(f"f {a} {a + 1} {a + n + 2}\nf {a} {a + n + 2} {a + n + 1}\n")
         os.replace(path + '.tmp', path)
     return os.path.abspath(path)
+def step_mesh(hx, hy, hz):
+    """GROUND=step: the box as a closed non-convex body, a slab with a wall 0.2 x 0.5 standing on
+    its +x end (an L's profile extruded along y): what a user's room, shelf or stair mesh is."""
+    path = os.path.join(GROUND_DIR[0], f"ground_step_{hx:.6g}_{hy:.6g}_{hz:.6g}.obj")
+    if os.path.exists(path): return os.path.abspath(path)
+    w = min(0.2, hx)
+    prof = [(-hx, -hz), (hx, -hz), (hx, hz), (hx, hz + 0.5), (hx - w, hz + 0.5), (hx - w, hz), (-hx, hz)]
+    n = len(prof); V = [(x, y, z) for y in (-hy, hy) for (x, z) in prof]
+    F = []
+    for i in range(n):  # the extruded sides, outward (the profile runs counter-clockwise in x, z)
+        j = (i + 1) % n
+        F += [(i, j + n, j), (i, i + n, j + n)]
+    for t in [(0, 1, 2), (0, 2, 5), (0, 5, 6), (5, 2, 3), (5, 3, 4)]:  # the caps: floor and wall
+        F += [(t[0], t[1], t[2]), (t[0] + n, t[2] + n, t[1] + n)]
+    with open(path + '.tmp', 'w') as f:
+        for v in V: f.write("v %.9g %.9g %.9g\n" % v)
+        for t in F: f.write("f %d %d %d\n" % (t[0] + 1, t[1] + 1, t[2] + 1))
+    os.replace(path + '.tmp', path)
+    return os.path.abspath(path)
 def ground(hx, hy, mu, pos=(0,0,-0.25), q=None, hz=0.25):
     b = {"name":"ground","box":[hx,hy,hz],"position":list(pos),"static":True,"friction":mu}
     if GROUND != 'box':
         # The judge still holds bodies against the box whose top the mesh is ("_box").
-        del b["box"]; b["mesh"] = ground_mesh(hx, hy, hz); b["_box"] = [hx, hy, hz]; b["scale"] = 1.0
+        del b["box"]; b["mesh"] = (step_mesh if GROUND == 'step' else ground_mesh)(hx, hy, hz)
+        b["_box"] = [hx, hy, hz]; b["scale"] = 1.0
     if q: b["orientation"]=q
     return b
+BOXES = os.environ.get('BOXES', 'box')
+DROPS = os.environ.get('DROPS', 'bunny-1500,spot,fandisk').split(',')
+def box_mesh(h):
+    """BOXES=obj: a dynamic box as a closed 12-triangle OBJ; BOXES=tessN (e.g. tess4): each face
+    cut into N x N squares, as a modelling tool exports a subdivided cube."""
+    n = 1 if BOXES == 'obj' else int(BOXES[4:] or 4)
+    path = os.path.join(GROUND_DIR[0], f"box_{BOXES}_{h[0]:.6g}_{h[1]:.6g}_{h[2]:.6g}.obj")
+    if os.path.exists(path): return os.path.abspath(path)
+    index = {}; V = []; F = []
+    def vid(p):
+        k = tuple(round(x, 12) for x in p)
+        if k not in index: index[k] = len(V) + 1; V.append(p)
+        return index[k]
+    for axis in range(3):
+        for sgn in (-1, 1):
+            u, w = (axis + 1) % 3, (axis + 2) % 3
+            def at(i, j):
+                p = [0.0, 0.0, 0.0]; p[axis] = sgn * h[axis]
+                p[u] = -h[u] + 2 * h[u] * i / n; p[w] = -h[w] + 2 * h[w] * j / n
+                return vid(p)
+            for i in range(n):
+                for j in range(n):
+                    a, b, c, d = at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)
+                    F += [(a, b, c), (a, c, d)] if sgn > 0 else [(a, c, b), (a, d, c)]
+    with open(path + '.tmp', 'w') as f:
+        for p in V: f.write("v %.12g %.12g %.12g\n" % tuple(p))
+        for t in F: f.write("f %d %d %d\n" % t)
+    os.replace(path + '.tmp', path)
+    return os.path.abspath(path)
 def boxb(name, h, pos, mu, q=None, v=None, extra=None):
     b = {"name":name,"box":list(h),"position":list(pos),"friction":mu}
+    if BOXES != 'box':
+        # The judge still measures the box ("_box"); the scene loads its mesh.
+        del b["box"]; b["mesh"] = box_mesh(h); b["_box"] = list(h); b["scale"] = 1.0
     if q: b["orientation"]=q
     if v: b["velocity"]=list(v)
     if extra: b.update(extra)
@@ -132,7 +187,7 @@ def gen(kind, rng):
         j = dict(kind=kind, T=T, a=a, down=down)
         return {"duration":T, "bodies":bodies}, j
     if kind == 'drop':
-        mesh = rng.choice(['bunny-1500','spot','fandisk'])
+        mesh = rng.choice(DROPS)
         V = load_obj(os.path.join(MESHES, f'{mesh}.obj'))
         lo=[min(v[i] for v in V) for i in range(3)]; hi=[max(v[i] for v in V) for i in range(3)]
         diag0=math.sqrt(sum((hi[i]-lo[i])**2 for i in range(3)))
@@ -170,6 +225,13 @@ def gen(kind, rng):
                     [rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-2, 0)],
                     extra={"angular_velocity": [rng.uniform(-6, 6) for _ in range(3)]})
         return {"duration": 6.0, "bodies": [ground(4, 4, mu), body]}, dict(kind='drop', verts=corners, diag=diag)
+    if kind == 'overhang':
+        # A box standing over the ground's -x edge, its centre of mass over the ground by 10-90 %
+        # of its half length: it stands (judged as a stack's top).
+        h = [rng.uniform(0.1, 0.5), rng.uniform(0.1, 0.5), rng.uniform(0.05, 0.5)]; mu = rng.uniform(0.4, 0.9)
+        L = 2.0; inside = rng.uniform(0.1, 0.9) * h[0]
+        bodies = [ground(L, L, mu), boxb("box", h, [-L + inside, rng.uniform(-1, 1), h[2]], mu)]
+        return {"duration": 4.0, "bodies": bodies}, dict(kind='stack', move=0.02, tiltlim=1.0, speed=0.05)
     if kind == 'roll':
         # A ball rolling down a slope without slipping: a = 5/7 g sin(theta) (a solid ball; the
         # scene's ball is a 320-triangle icosphere, whose facets cost it a little).

@@ -24,7 +24,7 @@ struct Closest {
 // Only triangles nearer than maxDistance are looked for (infinity: all); none found leaves the
 // distance at infinity.
 Closest closestOnBody(const CollisionBody& body, const Vec3& p, ContainmentScratch& s,
-                      double maxDistance = std::numeric_limits<double>::infinity()) {
+                      double maxDistance = std::numeric_limits<double>::infinity(), const FlushFaces* flush = nullptr) {
   const SphereTree& tree = body.sphereTree();
   const TriangleMesh& mesh = body.mesh();
   Closest best;
@@ -42,6 +42,9 @@ Closest closestOnBody(const CollisionBody& body, const Vec3& p, ContainmentScrat
       for (std::uint32_t i = tree.triangleOffsets[n]; i < tree.triangleOffsets[n + 1]; ++i) {
         const std::uint32_t t = tree.triangleList[i];
         const TrianglePoint tp = closestPointOnTriangle(p, mesh.corner(t, 0), mesh.corner(t, 1), mesh.corner(t, 2));
+        if (flush && std::abs(mesh.triangleNormal(t).dot(p - mesh.corner(t, 0))) <= flush->onSurface &&
+            flush->isFlush(flush->context, t))
+          continue;
         if (tp.distanceSquared < best.distanceSquared && tp.distanceSquared < reach) best = {tp.distanceSquared, t, tp};
       }
       continue;
@@ -122,8 +125,8 @@ FieldValue exactBodyField(const CollisionBody& body, const Vec3& pLocal, Contain
 }
 
 bool exactBodyFieldWithin(const CollisionBody& body, const Vec3& pLocal, double maxDistance, ContainmentScratch& scratch,
-                          FieldValue& f) {
-  const Closest c = closestOnBody(body, pLocal, scratch, maxDistance);
+                          FieldValue& f, const FlushFaces* flush) {
+  const Closest c = closestOnBody(body, pLocal, scratch, maxDistance, flush);
   if (!std::isfinite(c.distanceSquared)) return false;
   const double d = std::sqrt(c.distanceSquared);
   const Vec3 pseudo = featurePseudonormal(body, pLocal, c, scratch);

@@ -34,11 +34,25 @@ struct FieldValue {
   double errorBound = 0.0;
 };
 FieldValue exactBodyField(const CollisionBody& body, const Vec3& pLocal, ContainmentScratch& scratch);
+
+/// Triangles of the body that a point on them does not press through: `isFlush(context, t)` is
+/// asked only for a triangle whose plane p lies on (within `onSurface`; a flat face is often
+/// several triangles, and the field of the one beside p would stand in for the face). A corner of a box standing flush
+/// with a side face of the body (a box on an L-shaped body's floor, as wide as it) lies on that
+/// face, where the body's field is 0 -- so the corner, 1 cm below the floor's top, was not inside
+/// -- yet the box's material lies behind that face as the body's does: the face is not a contact
+/// surface there, and the field past it (the floor's top) is the corner's.
+struct FlushFaces {
+  double onSurface = 0.0;
+  const void* context = nullptr;
+  bool (*isFlush)(const void* context, std::uint32_t triangle) = nullptr;
+};
+
 /// exactBodyField where the surface lies within maxDistance of p, searching only that far (the
 /// cost of a point far from the surface is then a few sphere tests); false, `f` untouched, where
-/// it does not.
+/// it does not. With `flush`, the triangles it names under p are not the surface (FlushFaces).
 bool exactBodyFieldWithin(const CollisionBody& body, const Vec3& pLocal, double maxDistance, ContainmentScratch& scratch,
-                          FieldValue& f);
+                          FieldValue& f, const FlushFaces* flush = nullptr);
 
 
 /// Containment contacts (A's frame, normal from B toward A) when A lies wholly inside B or B

@@ -257,6 +257,9 @@ using CellPair = NodePair<ContactCell, ContactCell>;
 struct ProbedCorner {
   std::uint32_t vertex;
   bool inside;
+  Vec3 point = Vec3::Zero();  // A frame
+  Contact contact{};          // inside: the vertex's contact
+  Vec3 exit = Vec3::Zero();   // inside: the direction the vertex's body leaves along (A frame)
 };
 
 struct QueryScratch::Impl {
@@ -310,6 +313,7 @@ struct QueryScratch::Impl {
     // their area vectors per side and their share of `moment`.
     Vec3 insideVectorA, insideVectorB;
     double insideMoment;
+    Vec3 largestA = Vec3::Zero(), largestB = Vec3::Zero();  // each side's largest piece's area vector
   };
   std::vector<PatchSums> patchSums;
   // Triangles wholly inside the other body (addWhollyInsideTriangles): per triangle of the side
@@ -322,6 +326,7 @@ struct QueryScratch::Impl {
   std::array<std::vector<std::uint32_t>, 2> triedVertices;
   std::vector<Contact> vertexContacts;
   std::vector<std::uint8_t> patchHasVertices;
+  std::vector<double> patchVertexDepth;  // the deepest vertex contact per patch
   // Vertices already probed against a closed non-convex body's exact field in this answer
   // (cornersInsideContacts), per body (A, B).
   std::array<std::vector<ProbedCorner>, 2> probedCorners;
@@ -1355,6 +1360,38 @@ bool vertexOnFaceContacts(const PatchSide& patch, const PatchSide& faceted, cons
   return out.size() > before;
 }
 
+// Along the segment from `from` to `to` projected along n onto the plane of `triangles` (one
+// plane, normal n; `from` over one of them), the parameter in [0, 1] where it first leaves their
+// union: 1 when it never does. Each triangle covers an interval of the parameter (three
+// half-lines); the union is followed from 0.
+double leavesTrianglesAt(const TriangleMesh& mesh, std::span<const std::uint32_t> triangles, const Vec3& n,
+                         const Vec3& from, const Vec3& to) {
+  double reach = 0.0;
+  for (bool grew = true; grew && reach < 1.0;) {
+    grew = false;
+    for (std::uint32_t t : triangles) {
+      double lo = 0.0, hi = 1.0;
+      for (int k = 0; k < 3; ++k) {
+        const Vec3 a = mesh.corner(t, k), b = mesh.corner(t, (k + 1) % 3);
+        const double g0 = n.dot((b - a).cross(from - a)), g1 = n.dot((b - a).cross(to - a));
+        // g(s) = g0 + s (g1 - g0) >= 0 on the triangle's side of edge ab.
+        if (g1 == g0) {
+          if (g0 < 0.0) hi = -1.0;
+        } else if (g1 > g0) {
+          lo = std::max(lo, -g0 / (g1 - g0));
+        } else {
+          hi = std::min(hi, -g0 / (g1 - g0));
+        }
+      }
+      if (lo <= reach + 1e-12 && hi > reach + 1e-12) {
+        reach = hi;
+        grew = true;
+      }
+    }
+  }
+  return std::min(reach, 1.0);
+}
+
 // A patch's bounding vertices (a faceted patch's corners, a curved patch's support vertices: its
 // hull, which holds its deepest points along any direction) behind a flat patch (all its
 // triangles in one plane) of an open non-convex body, each over one of that patch's triangles:
@@ -1375,6 +1412,22 @@ bool cornersOverFlatPatchContacts(const PatchSide& flat, const PatchSide& other,
   const double offsetLocal = nLocal.dot(mesh.corner(triangles[0], 0));
   const double tolerance = 1e-9 * (flat.body.diagonal() + other.body.diagonal());
   const std::size_t before = out.size();
+  auto addContact = [&](const Vec3& v, double depth) {
+    Contact ci = c;
+    ci.normal = flatIsB ? n : Vec3(-n);
+    ci.point = v + 0.5 * depth * n;
+    ci.depth = depth;
+    ci.errorBound = 0.0;
+    out.push_back(ci);
+  };
+  // The vertices behind the plane: A frame, the flat body's frame, depth, over a triangle.
+  struct Behind {
+    Vec3 v, local;
+    double depth;
+    bool over;
+  };
+  std::array<Behind, CollisionBody::kMaxSpherePatchVertices> behind;
+  std::size_t count = 0;
   for (std::uint32_t id : other.boundingVertices()) {
     const Vec3 v = other.toA(other.body.mesh().vertices[id]);
     const Vec3 vLocal = flat.rotToA ? Vec3(flat.rotToA->transpose() * (v - flat.shift)) : v;  // flat body's frame
@@ -1387,15 +1440,46 @@ bool cornersOverFlatPatchContacts(const PatchSide& flat, const PatchSide& other,
       over = nLocal.dot((b - a).cross(onPlane - a)) >= 0.0 && nLocal.dot((d - b).cross(onPlane - b)) >= 0.0 &&
              nLocal.dot((a - d).cross(onPlane - d)) >= 0.0;
     }
-    if (!over) continue;
-    Contact ci = c;
-    ci.normal = flatIsB ? n : Vec3(-n);
-    ci.point = v + 0.5 * depth * n;
-    ci.depth = depth;
-    ci.errorBound = 0.0;
-    out.push_back(ci);
+    if (other.faceted && count < behind.size()) behind[count++] = {v, vLocal, depth, over};
+    if (over) addContact(v, depth);
+  }
+  // Where the patch reaches past the piece's rim (a box overhanging a table's edge), the corners
+  // over it are one side of the overlap only: the other side lies where the box's underside
+  // crosses the rim. With the inner corners alone the box turned about them and fell off the
+  // table, at every budget (cfm, exact's fallback). So between a corner over the piece and one
+  // behind the plane but past its rim, the point where the segment's foot leaves the piece's
+  // triangles is a contact too; the segment lies in the convex patch, so its depth there (linear
+  // along it) is the patch's penetration at that point or less. Faceted patches only (at most
+  // kMaxSpherePatchVertices corners); a curved patch's support vertices stand for its hull.
+  for (std::size_t i = 0; i < count; ++i) {
+    if (!behind[i].over) continue;
+    for (std::size_t j = 0; j < count; ++j) {
+      if (behind[j].over) continue;
+      const double leaves = leavesTrianglesAt(mesh, triangles, nLocal, behind[i].local, behind[j].local);
+      if (!(leaves < 1.0)) continue;
+      addContact(behind[i].v + leaves * (behind[j].v - behind[i].v),
+                 (1.0 - leaves) * behind[i].depth + leaves * behind[j].depth);
+    }
   }
   return out.size() > before;
+}
+
+// A face of N that a vertex of the other patch lies on (or within flushReach of), facing the way
+// the patch's own surface faces there: the vertex is the patch's farthest point along the face's
+// normal, so the patch lies behind the face's plane as N does. The face is not where the two
+// bodies press (detail::FlushFaces); the surface past it is.
+struct FlushContext {
+  const PatchSide& nonConvex;
+  const PatchSide& wholeBody;  // the convex body's root patch: a leaf's extent is not the body's
+  Vec3 vertex;                 // A frame
+  double tolerance;
+};
+
+bool isFlushFace(const void* context, std::uint32_t triangle) {
+  const FlushContext& f = *static_cast<const FlushContext*>(context);
+  const Vec3 nLocal = f.nonConvex.body.mesh().triangleNormal(triangle);
+  const Vec3 n = f.nonConvex.rotToA ? Vec3(*f.nonConvex.rotToA * nLocal) : nLocal;
+  return f.wholeBody.vertexExtent(n).hi <= n.dot(f.vertex) + f.tolerance;
 }
 
 // Vertices of a patch (a convex body's, faceted or curved, or a second closed non-convex body's)
@@ -1418,6 +1502,13 @@ bool cornersInsideContacts(const PatchSide& nonConvex, const PatchSide& convex, 
   // containment rule's case; searching only that far keeps a vertex far from N's surface at a
   // few sphere tests (with the whole body's radius, the 200-body bin's p99 frame doubled).
   const double reach = convex.radius;
+  // Flush, or set in from the face by up to 1e-3 of the smaller diagonal (a resting body's drift):
+  // the face's field there is the distance back to flush, not a penetration.
+  const double flushReach = 1e-3 * std::min(nonConvex.body.diagonal(), convex.body.diagonal());
+  // Only a convex polyhedron's whole extent says which side of a face its material lies on (a
+  // box's bottom-face leaf lies behind the floor's plane too, and the floor was skipped).
+  const bool flushFaces = convex.body.isConvexPolyhedron() && !convex.body.spherePatchVertices(0).empty();
+  const PatchSide wholeBody{convex.body, 0, true, convex.centre, convex.radius, convex.rotToA, convex.shift};
   bool anyInside = false;
   // A faceted patch's vertices; a curved patch's support vertices and, on a non-convex body, its
   // inner vertices (the flank of a bump lies between the hull's).
@@ -1434,9 +1525,12 @@ bool cornersInsideContacts(const PatchSide& nonConvex, const PatchSide& convex, 
       continue;
     }
     const Vec3 local = nonConvex.rotToA ? Vec3(nonConvex.rotToA->transpose() * (v - nonConvex.shift)) : v;
+    const FlushContext context{nonConvex, wholeBody, v, tolerance};
+    const detail::FlushFaces flush{flushReach, &context, &isFlushFace};
     detail::FieldValue f;
-    const bool inside = detail::exactBodyFieldWithin(nonConvex.body, local, reach, scratch, f) && f.distance < -tolerance;
-    probed.push_back({id, inside});
+    const bool inside = detail::exactBodyFieldWithin(nonConvex.body, local, reach, scratch, f, flushFaces ? &flush : nullptr) &&
+                        f.distance < -tolerance;
+    probed.push_back({id, inside, v});
     if (!inside) continue;
     anyInside = true;
     const Vec3 exit = nonConvex.rotToA ? Vec3(*nonConvex.rotToA * f.gradient) : f.gradient;  // A frame
@@ -1446,8 +1540,112 @@ bool cornersInsideContacts(const PatchSide& nonConvex, const PatchSide& convex, 
     ci.point = v + 0.5 * ci.depth * exit;
     ci.errorBound = 0.0;
     out.push_back(ci);
+    probed.back().contact = ci;
+    probed.back().exit = exit;
   }
   return anyInside;
+}
+
+// Where a convex body's edge leaves a closed non-convex body N between a corner inside N and one
+// outside, the overlap has a corner too: a box standing over the edge of an L-shaped body's floor
+// (or of a shelf, a step) had contacts at its inner corners only, turned about them and fell off,
+// with cfm and exact at every budget. For each such pair of probed corners whose outer corner lies
+// behind the inner corner's exit plane (so the segment runs under N's surface there, not up
+// through it), the first crossing of N's surface along the segment (a ray cast on N's triangles)
+// is a contact with the inner corner's normal, at the depth of that plane over it. The segment
+// lies in the convex body, so that depth is the body's penetration there or less. Once per answer,
+// after every pair has probed its corners (`probed`: the convex body's). Returns whether it added any.
+bool edgeExitContacts(const CollisionBody& nonConvex, const Pose& xfNFromA, const CollisionBody& convex,
+                      const Pose& xfAFromConvex, const std::vector<ProbedCorner>& probed, double tolerance,
+                      std::vector<Contact>& out) {
+  const std::size_t before = out.size();
+  // The outer corner may lie beyond every sphere of N that probed corners (a leaf at the rim).
+  const std::span<const std::uint32_t> corners = convex.spherePatchVertices(0);
+  for (const ProbedCorner& in : probed) {
+    if (!in.inside) continue;
+    for (const std::uint32_t id : corners) {
+      const auto seen = std::find_if(probed.begin(), probed.end(), [id](const ProbedCorner& p) { return p.vertex == id; });
+      if (seen != probed.end() && seen->inside) continue;
+      const Vec3 run = xfAFromConvex.apply(convex.mesh().vertices[id]) - in.point;
+      if (!(in.exit.dot(run) < in.contact.depth - tolerance)) continue;  // it rises out of N first
+      const Vec3 from = xfNFromA.apply(in.point);
+      const detail::RayHit hit = detail::firstHit(nonConvex, from, xfNFromA.rotation * run, 0.0, 1.0);
+      if (!hit.hit || !hit.leaving) continue;
+      const Vec3 crossing = in.point + hit.t * run;
+      const double depth = in.contact.depth - in.exit.dot(crossing - in.point);
+      if (!(depth > tolerance)) continue;
+      Contact c = in.contact;
+      c.depth = depth;
+      c.point = crossing + 0.5 * depth * in.exit;
+      out.push_back(c);
+    }
+  }
+  return out.size() > before;
+}
+
+// Where the edges of a faceted patch of N pass through a convex polyhedron O with none of their
+// vertices inside it (a box tipped over the edge of a step rests on that edge): each edge's part
+// inside O (the segment clipped by O's face planes) ends on O's surface, and those ends are the
+// contact, each at the depth O must travel along the pair's axis for the end to leave it, with
+// the pair's error bound (the axis is still the patches' hulls' choice: two faces touching at
+// depth 0 can pick a side face's axis, 0.3 m deep). The pair's separating-axis contact stood at
+// the spheres' D&O point instead, up to a sphere away from the edge -- under the step's top,
+// where it held the tipping box up (cfm at 256 tests and unlimited: a box 2-5 cm past the edge
+// stuck, tilted). O must be a whole convex polyhedron (its root's face planes are its
+// half-spaces). `convexIsB`: O is body B. Returns whether it added any.
+bool edgesThroughConvexContacts(const PatchSide& faceted, const PatchSide& convex, bool convexIsB, const Contact& c,
+                                std::vector<Contact>& out) {
+  const std::span<const Vec3f> faces = convex.body.sphereFaceNormals(0);
+  if (faces.empty()) return false;
+  const PatchSide whole{convex.body, 0, true, convex.centre, convex.radius, convex.rotToA, convex.shift};
+  std::array<std::pair<Vec3, double>, CollisionBody::kMaxSphereFaceNormals> halfSpaces;
+  for (std::size_t k = 0; k < faces.size(); ++k) {
+    const Vec3 f = convex.rotToA ? Vec3(*convex.rotToA * faces[k].cast<double>()) : Vec3(faces[k].cast<double>());
+    halfSpaces[k] = {f, whole.extent(f).hi};
+  }
+  const Vec3 leave = convexIsB ? Vec3(-c.normal) : c.normal;  // O's way out
+  const double tolerance = 1e-9 * (faceted.body.diagonal() + convex.body.diagonal());
+  // How far O travels along `leave` before q (fixed) leaves it through a face that faces q's way
+  // out (within 60 deg): an end lies on the side face that clipped it, which a tilt of 1e-3 rad
+  // would otherwise make its exit at depth 0.
+  constexpr double kMinFacingCos = 0.5;
+  auto travel = [&](const Vec3& q) {
+    double along = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < faces.size(); ++k) {
+      const double rate = -halfSpaces[k].first.dot(leave);
+      if (rate >= kMinFacingCos) along = std::min(along, (halfSpaces[k].second - halfSpaces[k].first.dot(q)) / rate);
+    }
+    return along;
+  };
+  const TriangleMesh& mesh = faceted.body.mesh();
+  const std::size_t before = out.size();
+  for (std::uint32_t t : faceted.body.sphereTree().triangles(faceted.sphere)) {
+    for (int k = 0; k < 3; ++k) {
+      // (An edge of two triangles of the patch comes twice; the manifold merges its ends.)
+      const std::uint32_t i = mesh.triangles[t][k], j = mesh.triangles[t][(k + 1) % 3];
+      const Vec3 p0 = faceted.toA(mesh.vertices[i]), p1 = faceted.toA(mesh.vertices[j]);
+      double t0 = 0.0, t1 = 1.0;
+      for (std::size_t h = 0; h < faces.size() && t0 < t1; ++h) {
+        const double g0 = halfSpaces[h].second - halfSpaces[h].first.dot(p0);
+        const double g1 = halfSpaces[h].second - halfSpaces[h].first.dot(p1);
+        if (g0 < 0.0 && g1 < 0.0) t1 = -1.0;
+        else if (g0 < 0.0) t0 = std::max(t0, g0 / (g0 - g1));
+        else if (g1 < 0.0) t1 = std::min(t1, g0 / (g0 - g1));
+      }
+      if (!(t1 - t0 > 1e-9)) continue;
+      for (const double at : {t0, t1}) {
+        if (at <= 0.0 || at >= 1.0) continue;  // the edge's own vertex: vertexOnFaceContacts' case
+        const Vec3 q = p0 + at * (p1 - p0);
+        const double depth = travel(q);
+        if (!(depth > tolerance) || !std::isfinite(depth)) continue;
+        Contact ci = c;  // its error bound too: the axis is the patches' hulls' choice
+        ci.depth = depth;
+        ci.point = q - 0.5 * depth * leave;
+        out.push_back(ci);
+      }
+    }
+  }
+  return out.size() > before;
 }
 
 // Whether a faceted patch is convex: every one of its vertices on or behind the plane of every one
@@ -1598,18 +1796,29 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
     // fandisk's: up to 1,024 support vertices) is its own hull, and the separating axis answers it
     // as before (probing those pairs too cost the 200-body bin 45 % more CPU per frame and doubled
     // its p99 frame; it did screw cfm's nut down its bolt, which now jams).
+    // An open body (a scanned bunny with holes) has no inside, but its vertices can be inside N:
+    // against N it is answered as a convex body is, one way only. Dropped on a closed floor with
+    // a wall (a room's, a stair's mesh), bunny-1500 got the hulls' answer, which pushed it down
+    // through the floor into the hull's pocket: 2-6 diagonals deep at 16-64 tests per frame, cfm
+    // and exact alike; and on a flat piece of N a curved patch's hull overlap let it sink 3-9 % at
+    // 256. (A flat piece of an open body is a floor: the rule below holds N on it.)
+    auto openCurved = [](const CollisionBody& b, bool convex, std::uint32_t sphere) {
+      return !convex && !b.isClosed() && b.sphereFaceNormals(sphere).size() != 1;
+    };
+    const bool openA = openCurved(bodyA, convexA, p.a), openB = openCurved(bodyB, convexB, p.b);
     const bool closedNonConvexA = !convexA && bodyA.isClosed(), closedNonConvexB = !convexB && bodyB.isClosed();
     const bool pocketA = closedNonConvexA && hasPocket(sideA), pocketB = closedNonConvexB && hasPocket(sideB);
-    const bool closedA = closedNonConvexA &&
-                         ((closedNonConvexB && (pocketA || pocketB || sideA.faceted || sideB.faceted)) ||
-                          (convexB && (pocketA || sideB.faceted)));
-    const bool closedB = !closedA && closedNonConvexB && convexA && (pocketB || sideA.faceted);
+    const bool closedA = closedNonConvexA && ((closedNonConvexB && (pocketA || pocketB || sideA.faceted || sideB.faceted)) ||
+                                              (convexB && (pocketA || sideB.faceted)) || openB);
+    const bool closedB = !closedA && closedNonConvexB && ((convexA && (pocketB || sideA.faceted)) || openA);
     if (closedA || closedB) {
       const PatchSide& body = closedA ? sideA : sideB;
       const bool bodyPocket = closedA ? pocketA : pocketB;
       const PatchSide& convex = closedA ? sideB : sideA;  // (or a second closed non-convex body: B)
       bool any = cornersInsideContacts(body, convex, closedA, c, s.containment, s.probedCorners[closedA ? 1 : 0], out);
-      if (!convex.body.isConvexPolyhedron()) {
+      if (!convex.body.isClosed()) {
+        // (An open body has no inside for N's vertices.)
+      } else if (!convex.body.isConvexPolyhedron()) {
         // Two closed non-convex bodies (spot dropped into a bin): each one's vertices in the other.
         any = cornersInsideContacts(convex, body, false, c, s.containment, s.probedCorners[0], out) || any;
       } else if (convex.faceted) {
@@ -1636,6 +1845,9 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
       const Extent e = convex.vertexExtent(c.normal);
       if (c.depth > e.hi - e.lo) continue;
       if (sideA.faceted && sideB.faceted && grazesAtZeroDepth(sideA, sideB, c)) continue;
+      if (body.faceted && convex.faceted && convex.body.isConvexPolyhedron() &&
+          edgesThroughConvexContacts(body, convex, closedA, c, s.edgeContacts))
+        continue;
       s.edgeContacts.push_back(c);
       continue;
     } else {
@@ -1683,6 +1895,12 @@ void sphereContacts(ContactModel model, const CollisionBody& bodyA, const Collis
     }
     out.push_back(c);
   }
+  // Where the convex body's edges leave N between its probed corners (edgeExitContacts).
+  const double tolerance = 1e-9 * (bodyA.diagonal() + bodyB.diagonal());
+  if (bodyA.isConvexPolyhedron() && bodyB.isClosed() && !bodyB.isConvexPolyhedron())
+    edgeExitContacts(bodyB, xfAFromB.inverse(), bodyA, Pose{}, s.probedCorners[0], tolerance, out);
+  if (bodyB.isConvexPolyhedron() && bodyA.isClosed() && !bodyA.isConvexPolyhedron())
+    edgeExitContacts(bodyA, Pose{}, bodyB, xfAFromB, s.probedCorners[1], tolerance, out);
   if (!vertexInside) out.insert(out.end(), s.edgeContacts.begin(), s.edgeContacts.end());
 }
 
@@ -1787,12 +2005,14 @@ void addToSide(QueryScratch::Impl::PatchSums& q, Vec3& patchNormal, bool sideA, 
     q.areaA += area;
     q.vectorA += areaVector;
     q.absoluteA += areaVector.norm();
+    if (areaVector.squaredNorm() > q.largestA.squaredNorm()) q.largestA = areaVector;
   } else {
     patchNormal += areaVector;
     q.centroidB += weightedCentroid;
     q.areaB += area;
     q.vectorB += areaVector;
     q.absoluteB += areaVector.norm();
+    if (areaVector.squaredNorm() > q.largestB.squaredNorm()) q.largestB = areaVector;
   }
 }
 
@@ -1892,6 +2112,20 @@ Vec3 planeSideNormal(const QueryScratch::Impl::PatchSums& q, const Vec3& summed)
   if (planeA && planeB) return fromA.dot(fromB) >= kCoplanarCos ? fromA : summed;
   if (planeA) return fromA;
   if (planeB) return fromB;
+  // Two faces pressed together whose overlap reaches an edge of one of them (a box standing over
+  // the edge of a step or a shelf): each side is its face plus slivers of the side faces as tall
+  // as the penetration, whose area vectors tilt the sum off the faces' normal by the depth over
+  // the overlap's size (0.3 deg at 1.7 mm on a 0.3 m overlap) -- a steady push over the edge, and
+  // the box slid off. Where the largest pieces of the two sides face each other exactly and carry
+  // all but kSliverShare of each side's area along their normal, the normal is theirs.
+  constexpr double kSliverShare = 0.05;
+  if (q.largestA.squaredNorm() > 0.0 && q.largestB.squaredNorm() > 0.0) {
+    const Vec3 faceA = -q.largestA.normalized(), faceB = q.largestB.normalized();
+    const bool faceOnFace = faceA.dot(faceB) >= kCoplanarCos;
+    if (faceOnFace && -q.vectorA.dot(faceA) >= (1.0 - kSliverShare) * q.absoluteA &&
+        q.vectorB.dot(faceB) >= (1.0 - kSliverShare) * q.absoluteB)
+      return faceA;
+  }
   return summed;
 }
 
@@ -2103,6 +2337,22 @@ void localNormal(const QueryScratch::Impl& s, std::uint32_t pair, Contact& c) {
   c.normal = n / len;
 }
 
+// The penetration along the normal line through a point on both surfaces (a point of the
+// intersection curve): how far it moves along +n before it leaves B plus how far along -n before it
+// leaves A (each ray starts past the triangles at the point; an open sheet, which the point lies
+// on, adds nothing: the other body's part is how far it reaches behind the sheet). Moves c.point to
+// the middle of that span and returns its length, 0 where the line only grazes.
+double lineThrough(const CollisionBody& bodyA, const CollisionBody& bodyB, const MatrixPose& bFromA, const Vec3& n,
+                   Contact& c) {
+  if (!bodyA.isClosed() && !bodyB.isClosed()) return 0.0;
+  detail::RayHit exitA, exitB;
+  const double insideB = detail::distanceToLeave(bodyB, bFromA.apply(c.point), bFromA.rotation * n, 1e-9 * bodyB.diagonal(), exitB);
+  const double insideA = detail::distanceToLeave(bodyA, c.point, -n, 1e-9 * bodyA.diagonal(), exitA);
+  if (!(insideA > 0.0) && !(insideB > 0.0)) return 0.0;
+  c.point += 0.5 * (insideB - insideA) * n;
+  return insideA + insideB;
+}
+
 // Per-point depth in the exact model: the vertices of either body that lie inside the other,
 // next to a patch, each a contact with its own penetration along the normal line through it --
 // how far it moves along +n before it leaves B plus how far along -n before it leaves A (one ray
@@ -2124,6 +2374,7 @@ void vertexContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, cons
                     QueryScratch::Impl& s) {
   s.vertexContacts.clear();
   s.patchHasVertices.assign(s.patchNormal.size(), 0);
+  s.patchVertexDepth.assign(s.patchNormal.size(), 0.0);
   if (!complete || s.volumePairs.empty()) return;
   const MatrixPose aFromB(xfAFromB);
   const MatrixPose bFromA(xfAFromB.inverse());
@@ -2172,6 +2423,7 @@ void vertexContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, cons
       c.featureKind = ContactFeature::kTriangle;
       s.vertexContacts.push_back(c);
       s.patchHasVertices[pair.patch] = 1;
+      s.patchVertexDepth[pair.patch] = std::max(s.patchVertexDepth[pair.patch], c.depth);
     }
   };
   for (const auto& pair : s.volumePairs) {
@@ -2296,9 +2548,25 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
   penetrationVolumeNormals(bodyA, bodyB, xfAFromB, patches, complete, s);
   vertexContacts(bodyA, bodyB, xfAFromB, complete, s);
   out.insert(out.end(), s.vertexContacts.begin(), s.vertexContacts.end());
+  const MatrixPose bFromA(xfAFromB.inverse());
   for (auto& kc : s.exactContacts) {
     const std::uint32_t patch = s.patchParent[kc.pair];
-    if (s.patchHasVertices[patch] != 0) continue;
+    if (s.patchHasVertices[patch] != 0) {
+      const double depth = lineThrough(bodyA, bodyB, bFromA, s.patchNormal[patch], kc.contact);
+      if (depth > patchTol && depth <= s.patchVertexDepth[patch] + patchTol) {
+        // A point of the intersection curve that the line along the normal finds inside both
+        // bodies: where a box standing over an edge of the other body crosses it, a corner of
+        // their overlap that is no body's vertex (with the vertices alone the box turned about
+        // its inner ones and fell off). On a curved patch's rim the line only grazes (depth 0).
+        // The overlap's corners between the vertices are no deeper than its deepest vertex; a
+        // line deeper than that ran along a face it lies in (a box flush against a wall: up the
+        // wall's face to its top, 2 m).
+        kc.contact.normal = s.patchNormal[patch];
+        kc.contact.depth = depth;
+        out.push_back(kc.contact);
+      }
+      continue;
+    }
     kc.contact.normal = s.patchNormal[patch];
     // Coplanar faces pressed together (their patches hold no crossing pair) touch: no volume lies
     // between them. (Their pieces' areas differ -- a wall against a box's face -- and the volume

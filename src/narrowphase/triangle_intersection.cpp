@@ -131,6 +131,11 @@ bool intersectTriangles(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Ve
   out.points[0] = tA0 >= tB0 ? segA[0] : segB[0];
   out.points[1] = tA1 <= tB1 ? segA[1] : segB[1];
   out.count = 2;
+  // Segments that overlap in one point only: the triangles meet there without crossing along a
+  // segment (a box's side face and a perpendicular face of a step, both ending at the step's top
+  // edge, met at one point; read as crossing, the pair got an intersection volume of its own,
+  // and a box standing exactly on the step got a sideways contact 0.36 m deep).
+  if (std::min(tA1, tB1) - std::max(tA0, tB0) <= tolerance) out.touching = true;
   return true;
 }
 

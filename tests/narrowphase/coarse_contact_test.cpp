@@ -29,6 +29,7 @@
 namespace clod {
 namespace {
 
+using test::octreeBodyForCfm;
 using test::settingsFor;
 
 constexpr double kPi = 3.14159265358979323846;
@@ -36,16 +37,6 @@ constexpr double kDegree = kPi / 180.0;
 
 double angleBetween(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
 
-// An octree sphere-tree of depth 3 and the default closest feature map, no contact tree: the
-// cfm model's view of a body as `clod experiment flat-contact` bakes it.
-CollisionBody octreeBodyForCfm(const TriangleMesh& mesh) {
-  BakeSettings settings;
-  settings.sphereTree.method = SphereTreeMethod::kOctree;
-  settings.sphereTree.depth = 3;
-  settings.measureFit = false;
-  settings.buildContactTree = false;
-  return CollisionBody::fromBake(bakeMesh(mesh, settings).contents);
-}
 
 // The bake of tests/dynamics/world_test.cpp (octree sphere-tree of depth 3, default closest
 // feature map, contact tree of depth 6), so these are the trees the box-drop test runs on.

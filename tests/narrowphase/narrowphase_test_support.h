@@ -19,6 +19,17 @@
 
 namespace clod::test {
 
+/// An octree sphere-tree of depth 3 and the default closest feature map, no contact tree: the
+/// cfm model's view of a body as `clod experiment flat-contact` bakes it (cfm and exact use these).
+inline CollisionBody octreeBodyForCfm(const TriangleMesh& mesh) {
+  BakeSettings settings;
+  settings.sphereTree.method = SphereTreeMethod::kOctree;
+  settings.sphereTree.depth = 3;
+  settings.measureFit = false;
+  settings.buildContactTree = false;
+  return CollisionBody::fromBake(bakeMesh(mesh, settings).contents);
+}
+
 /// A body with sphere-tree (medial, 8-ary, `depth` levels below the root), closest feature map
 /// (16 root stacks: finer than the paper's 10 so the sphere tests' tolerances stay small) and
 /// contact tree (errorRel 2e-3). The map and the tree are the expensive parts (most of the

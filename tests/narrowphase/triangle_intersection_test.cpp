@@ -126,6 +126,21 @@ TEST(TriangleIntersection, TouchingAndParallelCases) {
   // A face pushed 0.1 through another: penetration measured on the corners below.
   ASSERT_TRUE(intersectTriangles(Vec3(0.1, 0.1, -0.1), Vec3(0.1, 0.1, 1), Vec3(0.3, 0.1, 1), a0, a1, a2, 1e-12, out));
   EXPECT_NEAR(out.penetrationBelowB, 0.1, 1e-12);
+  // Two perpendicular faces, each straddling the other's plane, whose parts on the planes' common
+  // line (x = 0.25, y = 1) meet in one point, (0.25, 1, 0): a box's side face above a step's top
+  // edge and the step's side face below it. One point, touching (read as crossing, the pair got a
+  // penetration volume of its own and a sideways contact 0.36 m deep).
+  const Vec3 side0(0.25, 0.7, 0.0), side1(0.25, 1.2, 0.0), side2(0.25, 0.7, 0.5);  // plane x = 0.25, z >= 0
+  const Vec3 step0(-1.0, 1.0, 0.0), step1(1.0, 1.0, 0.0), step2(0.0, 1.0, -0.5);   // plane y = 1, z <= 0
+  ASSERT_TRUE(intersectTriangles(side0, side1, side2, step0, step1, step2, 1e-12, out));
+  EXPECT_LT((out.points[0] - Vec3(0.25, 1.0, 0.0)).norm(), 1e-12);
+  EXPECT_LT((out.points[1] - Vec3(0.25, 1.0, 0.0)).norm(), 1e-12);
+  EXPECT_TRUE(out.touching);
+  // The step's face raised 0.1: they cross along a segment 0.1 long.
+  const Vec3 up(0.0, 0.0, 0.1);
+  ASSERT_TRUE(intersectTriangles(side0, side1, side2, step0 + up, step1 + up, step2 + up, 1e-12, out));
+  EXPECT_NEAR((out.points[1] - out.points[0]).norm(), 0.1, 1e-12);  // z in [0, 0.1] on the line
+  EXPECT_FALSE(out.touching);
 }
 
 }  // namespace
