@@ -759,6 +759,20 @@ struct PatchSide {
 
   Vec3 toA(const Vec3& local) const { return rotToA ? Vec3(*rotToA * local + shift) : local; }
 
+  // The same body's faceted patch of another sphere (its root: a whole convex body), same frame.
+  PatchSide facetedAt(std::uint32_t other) const { return {body, other, true, centre, radius, rotToA, shift}; }
+
+  // Its face planes in A's frame as half-spaces n . x <= support, the patch's extent along n.
+  using HalfSpaces = std::array<std::pair<Vec3, double>, CollisionBody::kMaxSphereFaceNormals>;
+  std::span<const std::pair<Vec3, double>> halfSpaces(HalfSpaces& out) const {
+    const std::span<const Vec3f> faces = body.sphereFaceNormals(sphere);
+    for (std::size_t k = 0; k < faces.size(); ++k) {
+      const Vec3 f = rotToA ? Vec3(*rotToA * faces[k].cast<double>()) : Vec3(faces[k].cast<double>());
+      out[k] = {f, extent(f).hi};
+    }
+    return {out.data(), faces.size()};
+  }
+
   // The vertices that bound the side: the faceted patch's, else a curved patch's support vertices.
   std::span<const std::uint32_t> boundingVertices() const {
     return faceted ? body.spherePatchVertices(sphere) : body.sphereSupportVertices(sphere);
@@ -1248,13 +1262,10 @@ bool vertexOnFaceContacts(const PatchSide& patch, const PatchSide& faceted, cons
   constexpr double kMaxDetourRel = 0.02;
   const std::uint32_t root = 0;
   const bool whole = !faceted.body.sphereFaceNormals(root).empty();
-  const PatchSide body{faceted.body, whole ? root : faceted.sphere, true, faceted.centre, faceted.radius, faceted.rotToA, faceted.shift};
+  const PatchSide body = faceted.facetedAt(whole ? root : faceted.sphere);
   const std::span<const Vec3f> faces = faceted.body.sphereFaceNormals(body.sphere);
-  std::array<std::pair<Vec3, double>, CollisionBody::kMaxSphereFaceNormals> halfSpaces;
-  for (std::size_t k = 0; k < faces.size(); ++k) {
-    const Vec3 f = faceted.rotToA ? Vec3(*faceted.rotToA * faces[k].cast<double>()) : Vec3(faces[k].cast<double>());
-    halfSpaces[k] = {f, body.extent(f).hi};
-  }
+  PatchSide::HalfSpaces halfSpaceStore;
+  const std::span<const std::pair<Vec3, double>> halfSpaces = body.halfSpaces(halfSpaceStore);
   const double tolerance = 1e-9 * (patch.body.diagonal() + faceted.body.diagonal());
   const bool facetedIsB = toward.dot(c.normal) > 0.0;
   const std::size_t before = out.size();
@@ -1508,7 +1519,7 @@ bool cornersInsideContacts(const PatchSide& nonConvex, const PatchSide& convex, 
   // Only a convex polyhedron's whole extent says which side of a face its material lies on (a
   // box's bottom-face leaf lies behind the floor's plane too, and the floor was skipped).
   const bool flushFaces = convex.body.isConvexPolyhedron() && !convex.body.spherePatchVertices(0).empty();
-  const PatchSide wholeBody{convex.body, 0, true, convex.centre, convex.radius, convex.rotToA, convex.shift};
+  const PatchSide wholeBody = convex.facetedAt(0);
   bool anyInside = false;
   // A faceted patch's vertices; a curved patch's support vertices and, on a non-convex body, its
   // inner vertices (the flank of a bump lies between the hull's).
@@ -1604,14 +1615,9 @@ bool edgeExitContacts(const CollisionBody& nonConvex, const Pose& xfNFromA, cons
 // half-spaces). `convexIsB`: O is body B. Returns whether it added any.
 bool edgesThroughConvexContacts(const PatchSide& faceted, const PatchSide& convex, bool convexIsB, const Contact& c,
                                 std::vector<Contact>& out) {
-  const std::span<const Vec3f> faces = convex.body.sphereFaceNormals(0);
-  if (faces.empty()) return false;
-  const PatchSide whole{convex.body, 0, true, convex.centre, convex.radius, convex.rotToA, convex.shift};
-  std::array<std::pair<Vec3, double>, CollisionBody::kMaxSphereFaceNormals> halfSpaces;
-  for (std::size_t k = 0; k < faces.size(); ++k) {
-    const Vec3 f = convex.rotToA ? Vec3(*convex.rotToA * faces[k].cast<double>()) : Vec3(faces[k].cast<double>());
-    halfSpaces[k] = {f, whole.extent(f).hi};
-  }
+  PatchSide::HalfSpaces halfSpaceStore;
+  const std::span<const std::pair<Vec3, double>> halfSpaces = convex.facetedAt(0).halfSpaces(halfSpaceStore);
+  if (halfSpaces.empty()) return false;
   const Vec3 leave = convexIsB ? Vec3(-c.normal) : c.normal;  // O's way out
   const double tolerance = 1e-9 * (faceted.body.diagonal() + convex.body.diagonal());
   // How far O travels along `leave` before q (fixed) leaves it through a face that faces q's way
@@ -1620,7 +1626,7 @@ bool edgesThroughConvexContacts(const PatchSide& faceted, const PatchSide& conve
   constexpr double kMinFacingCos = 0.5;
   auto travel = [&](const Vec3& q) {
     double along = std::numeric_limits<double>::infinity();
-    for (std::size_t k = 0; k < faces.size(); ++k) {
+    for (std::size_t k = 0; k < halfSpaces.size(); ++k) {
       const double rate = -halfSpaces[k].first.dot(leave);
       if (rate >= kMinFacingCos) along = std::min(along, (halfSpaces[k].second - halfSpaces[k].first.dot(q)) / rate);
     }
@@ -1634,7 +1640,7 @@ bool edgesThroughConvexContacts(const PatchSide& faceted, const PatchSide& conve
       const std::uint32_t i = mesh.triangles[t][k], j = mesh.triangles[t][(k + 1) % 3];
       const Vec3 p0 = faceted.toA(mesh.vertices[i]), p1 = faceted.toA(mesh.vertices[j]);
       double t0 = 0.0, t1 = 1.0;
-      for (std::size_t h = 0; h < faces.size() && t0 < t1; ++h) {
+      for (std::size_t h = 0; h < halfSpaces.size() && t0 < t1; ++h) {
         const double g0 = halfSpaces[h].second - halfSpaces[h].first.dot(p0);
         const double g1 = halfSpaces[h].second - halfSpaces[h].first.dot(p1);
         if (g0 < 0.0 && g1 < 0.0) t1 = -1.0;

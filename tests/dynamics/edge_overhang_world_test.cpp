@@ -23,9 +23,7 @@ namespace {
 
 constexpr double kHalf = 0.25;  // the box's half side
 
-double tiltDegrees(const Quat& q) {
-  return std::acos(std::clamp((q * Vec3::UnitZ()).z(), -1.0, 1.0)) * 180.0 / 3.14159265358979323846;
-}
+using test::tiltDegrees;
 
 struct Support {
   const char* name;

@@ -62,10 +62,7 @@ World groundWorld(ContactModel model, std::uint64_t budget, double side) {
   return world;
 }
 
-double tiltDegrees(const Quat& q) {
-  const Vec3 up = q * Vec3::UnitZ();
-  return std::acos(std::clamp(up.z(), -1.0, 1.0)) * 180.0 / M_PI;
-}
+using test::tiltDegrees;
 
 const std::vector<ContactModel>& models() {
   static const std::vector<ContactModel> all{ContactModel::kCfm, ContactModel::kExact, ContactModel::kContactTree};

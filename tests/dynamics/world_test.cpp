@@ -60,10 +60,7 @@ void addStaticGround(World& world, const std::shared_ptr<const CollisionBody>& s
   world.addBody(ground);
 }
 
-double tiltDegrees(const Quat& q) {
-  const Vec3 up = q * Vec3::UnitZ();
-  return std::acos(std::clamp(up.z(), -1.0, 1.0)) * 180.0 / M_PI;
-}
+using test::tiltDegrees;
 
 struct Collision {
   double energyBefore, energyAfter;

@@ -45,6 +45,12 @@ inline double bruteForceSurfaceDistance(const TriangleMesh& ma, const Pose& pa, 
   return std::sqrt(best);
 }
 
+/// How far a body's up axis has turned from the world's (degrees).
+inline double tiltDegrees(const Quat& q) {
+  const Vec3 up = q * Vec3::UnitZ();
+  return std::acos(std::clamp(up.z(), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
 /// A unit cube (side 1) baked as above, once per test binary.
 inline const std::shared_ptr<const CollisionBody>& unitWorldCube() {
   static const std::shared_ptr<const CollisionBody> shape = bakeWorldShape(makeBox(Vec3(0.5, 0.5, 0.5)));
