@@ -17,6 +17,7 @@
 #include "clod/closest_feature_map.h"
 #include "clod/contact_tree.h"
 #include "clod/mesh.h"
+#include "clod/proximity.h"
 #include "clod/sphere_tree.h"
 
 namespace clod {
@@ -138,6 +139,11 @@ public:
   std::uint32_t triangleNeighbour(std::uint32_t t, int k) const noexcept { return neighbours_[3 * std::size_t{t} + k]; }
   static constexpr std::uint32_t kNoNeighbour = 0xffffffffu;
 
+  /// The closest point on triangle t to p (closestPointOnTriangle), with the triangle's needle /
+  /// sliver test made once at construction instead of per call: the exact field queries of the
+  /// narrow phase (vertex depths, containment) spent as long on that test as on the point.
+  TrianglePoint closestPointOnTriangle(const Vec3& p, std::uint32_t t) const noexcept;
+
   /// A box hierarchy over the mesh's triangles (the proximity layer's), built on first use --
   /// O(T log T), thread-safe -- and shared by copies of the body: the exact closest-distance
   /// queries (World::separation, QuerySettings::marginAbs) descend it.
@@ -175,6 +181,7 @@ private:
   std::vector<std::uint32_t> innerVertices_;
   std::vector<Vec3f> vertexNormals_;
   std::vector<std::uint32_t> neighbours_;  // 3 per triangle (triangleNeighbour)
+  std::vector<std::uint8_t> thinTriangle_;  // per triangle: detail::isThinTriangle (closestPointOnTriangle)
   double diagonal_ = 0.0;
   bool convexPolyhedron_ = false;     // closed and convex (isConvexPolyhedron)
   bool closed_ = false;               // every edge shared by exactly two triangles (isClosed)

@@ -10,6 +10,7 @@
 #include "clod/bake.h"
 #include "clod/cell_support.h"
 #include "clod/error.h"
+#include "proximity/triangle_closest_point.h"
 #include "patch_hull.h"
 #include "proximity/triangle_bvh.h"
 
@@ -76,6 +77,9 @@ CollisionBody::CollisionBody(TriangleMesh mesh, SphereTree tree)
     for (std::uint32_t i = tree_.levelBegin(l); i < tree_.levelEnd(l); ++i) sphereLevel_[i] = l;
   }
   diagonal_ = mesh_.bounds().diagonal();
+  thinTriangle_.resize(mesh_.triangleCount());
+  for (std::uint32_t t = 0; t < mesh_.triangleCount(); ++t)
+    thinTriangle_[t] = detail::isThinTriangle(mesh_.corner(t, 0), mesh_.corner(t, 1), mesh_.corner(t, 2));
 
   faceNormalOffsets_.assign(1, 0);
   patchVertexOffsets_.assign(1, 0);
@@ -337,6 +341,11 @@ const ClosestFeatureMap& CollisionBody::closestFeatureMap() const noexcept {
 const ContactTree& CollisionBody::contactTree() const noexcept {
   CLOD_ASSERT(contactTree_.has_value());
   return *contactTree_;
+}
+
+TrianglePoint CollisionBody::closestPointOnTriangle(const Vec3& p, std::uint32_t t) const noexcept {
+  const Vec3 &a = mesh_.corner(t, 0), &b = mesh_.corner(t, 1), &c = mesh_.corner(t, 2);
+  return thinTriangle_[t] ? detail::closestPointOnThinTriangle(p, a, b, c) : detail::closestPointOnRegularTriangle(p, a, b, c);
 }
 
 }  // namespace clod

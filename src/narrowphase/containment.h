@@ -16,14 +16,19 @@ namespace clod::detail {
 
 /// Working memory of containmentContacts (reused: no allocation once grown).
 struct ContainmentScratch {
-  std::vector<std::pair<double, std::uint32_t>> heap;  // best-first sphere-tree search
-  std::vector<std::uint32_t> triangles;                // triangles around a closest vertex/edge
+  struct BoxEntry {
+    double lowerBound;    // squared distance to the slot's box
+    std::uint32_t child;  // node index (count 0), or first position in the BVH's order
+    std::uint32_t count;  // triangles of a leaf slot
+  };
+  std::vector<BoxEntry> stack;           // best-first triangle-BVH search
+  std::vector<std::uint32_t> triangles;  // triangles around a closest vertex/edge
 };
 
 /// Signed distance of a body's surface at p (body frame), negative inside, with the field's
 /// gradient direction (unit; points toward increasing distance, i.e. out of the body at its
 /// nearest surface) and an error bound on the distance (0: exact). A best-first search of the
-/// sphere-tree's leaves with closestPointOnTriangle (proximity.h), signed by the angle-weighted
+/// body's triangle BVH with closestPointOnTriangle (proximity.h), signed by the angle-weighted
 /// pseudonormal of the closest feature (Baerentzen & Aanaes 2005; exact for closed, consistently
 /// oriented meshes). O(log T) typical, no allocation once the scratch has grown. The contact tree
 /// is not used: deep inside a body its coarse cells' gradient is far off (a sphere 0.7 inside a
@@ -49,7 +54,7 @@ struct FlushFaces {
 };
 
 /// exactBodyField where the surface lies within maxDistance of p, searching only that far (the
-/// cost of a point far from the surface is then a few sphere tests); false, `f` untouched, where
+/// cost of a point far from the surface is then a few box tests); false, `f` untouched, where
 /// it does not. With `flush`, the triangles it names under p are not the surface (FlushFaces).
 bool exactBodyFieldWithin(const CollisionBody& body, const Vec3& pLocal, double maxDistance, ContainmentScratch& scratch,
                           FieldValue& f, const FlushFaces* flush = nullptr);

@@ -1511,7 +1511,7 @@ bool cornersInsideContacts(const PatchSide& nonConvex, const PatchSide& convex, 
   const double tolerance = 1e-9 * (nonConvex.body.diagonal() + convex.body.diagonal());
   // A vertex deeper in N than its patch's sphere is large is found by a coarser pair, or is the
   // containment rule's case; searching only that far keeps a vertex far from N's surface at a
-  // few sphere tests (with the whole body's radius, the 200-body bin's p99 frame doubled).
+  // few box tests (with the whole body's radius, the 200-body bin's p99 frame doubled).
   const double reach = convex.radius;
   // Flush, or set in from the face by up to 1e-3 of the smaller diagonal (a resting body's drift):
   // the face's field there is the distance back to flush, not a penetration.

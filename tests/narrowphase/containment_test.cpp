@@ -188,21 +188,30 @@ TEST(Containment, AnOpenMeshHasNoInside) {
   }
 }
 
-TEST(Containment, ExactFieldThroughTheSphereTreeMatchesMeshDistance) {
-  // The sphere-tree path of the containment field (bodies without a contact tree) against the
-  // proximity layer's exact signed distance, at random points around closed meshes.
+TEST(Containment, ExactFieldThroughTheTriangleBvhMatchesMeshDistance) {
+  // The containment field (a best-first search of the body's triangle BVH, signed by the closest
+  // feature's pseudonormal) against the proximity layer's exact signed distance, at random points
+  // around closed meshes: boxes, an icosphere and spot (5,856 triangles, non-convex). Searched
+  // within a radius, it answers exactly where the surface lies within it.
   const Bodies& b = bodies();
+  static const CollisionBody spot = test::makeTestBody(test::loadUnitMesh("spot.obj"), 1, false, false);
   std::mt19937_64 rng(7);
-  std::uniform_real_distribution<double> u(-1.4, 1.4);
+  std::uniform_real_distribution<double> u(-1.4, 1.4), radius(0.0, 0.5);
   detail::ContainmentScratch scratch;
-  for (const CollisionBody* body : {&b.bigBox, &b.bigSphere, &b.smallBox}) {
+  for (const CollisionBody* body : {&b.bigBox, &b.bigSphere, &b.smallBox, &spot}) {
     const MeshDistance oracle(body->mesh());
     for (int i = 0; i < 300; ++i) {
       const Vec3 p(u(rng), u(rng), u(rng));
       const detail::FieldValue f = detail::exactBodyField(*body, p, scratch);
+      const double expected = oracle.signedDistance(p);
       // Exact in double precision: both take the minimum of closestPointOnTriangle.
-      EXPECT_NEAR(f.distance, oracle.signedDistance(p), 1e-12 * body->diagonal()) << p.transpose();
+      EXPECT_NEAR(f.distance, expected, 1e-12 * body->diagonal()) << p.transpose();
       EXPECT_NEAR(f.gradient.norm(), 1.0, 1e-9);
+      const double r = radius(rng) * body->diagonal();
+      if (std::abs(std::abs(expected) - r) <= 1e-9 * body->diagonal()) continue;  // a tie at the radius
+      detail::FieldValue within;
+      EXPECT_EQ(detail::exactBodyFieldWithin(*body, p, r, scratch, within), std::abs(expected) < r) << p.transpose();
+      if (std::abs(expected) < r) EXPECT_NEAR(within.distance, expected, 1e-12 * body->diagonal());
     }
   }
 }
