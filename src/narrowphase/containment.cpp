@@ -68,7 +68,7 @@ Closest closestOnBody(const CollisionBody& body, const Vec3& p, ContainmentScrat
     const detail::Bvh4Node& node = nodes[e.child];
     const std::size_t first = s.stack.size();
     for (int k = 0; k < 4; ++k) {
-      if (node.child[k] == detail::Bvh4Node::kEmpty && node.count[k] == 0) continue;
+      if (node.emptySlot(k)) continue;
       const double bound = slotDistanceSquared(node, k, p);
       if (bound * kBoxBoundSlack >= std::min(best.distanceSquared, reach)) continue;
       s.stack.push_back({bound, node.child[k], node.count[k]});
@@ -117,13 +117,12 @@ Vec3 featurePseudonormal(const CollisionBody& body, const Vec3& p, const Closest
     }
     const detail::Bvh4Node& node = bvh.nodes()[e.child];
     for (int k = 0; k < 4; ++k) {
-      if (node.child[k] == detail::Bvh4Node::kEmpty && node.count[k] == 0) continue;
+      if (node.emptySlot(k)) continue;
       if (slotDistanceSquared(node, k, p) * kBoxBoundSlack > reach * reach) continue;
       s.stack.push_back({0.0, node.child[k], node.count[k]});
     }
   }
-  std::sort(s.triangles.begin(), s.triangles.end());
-  s.triangles.erase(std::unique(s.triangles.begin(), s.triangles.end()), s.triangles.end());
+  std::sort(s.triangles.begin(), s.triangles.end());  // one summation order, whatever the BVH's
   Vec3 sum = Vec3::Zero();
   for (std::uint32_t t : s.triangles) {
     double weight = 1.0;

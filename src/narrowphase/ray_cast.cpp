@@ -62,7 +62,7 @@ RayHit firstHit(const CollisionBody& body, const Vec3& origin, const Vec3& dir, 
   while (top > 0) {
     const Bvh4Node& node = bvh.nodes()[stack[--top]];
     for (int s = 0; s < 4; ++s) {
-      if (node.child[s] == Bvh4Node::kEmpty && node.count[s] == 0) continue;
+      if (node.emptySlot(s)) continue;
       if (!(slotEntry(node, s, origin, inverse, tMin, std::min(tMax, best.t)) < best.t)) continue;
       if (node.count[s] == 0) {
         stack[top++] = node.child[s];

@@ -62,17 +62,12 @@ bool segmentCrossesTriangle(const Vec3& p, const Vec3& q, const Vec3& a, const V
 constexpr std::uint32_t kRoot = 0xffffffffu;  // slot reference of a whole hierarchy
 
 // A slot reference is node * 4 + slot of a TriangleBvh node, or kRoot.
-bool isEmptySlot(const Bvh4Node& n, int s) { return n.child[s] == Bvh4Node::kEmpty && n.count[s] == 0; }
-
-Aabb slotBox(const Bvh4Node& n, int s) {
-  return Aabb{Vec3(n.minX[s], n.minY[s], n.minZ[s]), Vec3(n.maxX[s], n.maxY[s], n.maxZ[s])};
-}
 
 Aabb refBox(const TriangleBvh& t, std::uint32_t ref) {
-  if (ref != kRoot) return slotBox(t.nodes()[ref >> 2], int(ref & 3));
+  if (ref != kRoot) return t.nodes()[ref >> 2].slotBox(int(ref & 3));
   Aabb box;
   for (int s = 0; s < 4; ++s)
-    if (!isEmptySlot(t.nodes()[0], s)) box.extend(slotBox(t.nodes()[0], s));
+    if (!t.nodes()[0].emptySlot(s)) box.extend(t.nodes()[0].slotBox(s));
   return box;
 }
 
@@ -163,7 +158,7 @@ Separation separationBetween(const CollisionBody& shapeA, const Pose& poseA, con
   auto children = [](const TriangleBvh& t, std::uint32_t ref, auto&& each) {
     const std::uint32_t node = ref == kRoot ? 0 : t.nodes()[ref >> 2].child[ref & 3];
     for (int s = 0; s < 4; ++s)
-      if (!isEmptySlot(t.nodes()[node], s)) each(node * 4 + std::uint32_t(s));
+      if (!t.nodes()[node].emptySlot(s)) each(node * 4 + std::uint32_t(s));
   };
   const double rootBound = boxLowerBound(refBox(ta, kRoot), refBox(tb, kRoot), xf, absRotation);
   push(kRoot, kRoot);

@@ -22,6 +22,9 @@ struct alignas(64) Bvh4Node {
   /// in TriangleBvh::order(); empty slot: kEmpty with count 0 and an empty (inverted) box.
   std::uint32_t child[4];
   std::uint32_t count[4];
+
+  bool emptySlot(int s) const noexcept { return child[s] == kEmpty && count[s] == 0; }
+  Aabb slotBox(int s) const { return Aabb{Vec3(minX[s], minY[s], minZ[s]), Vec3(maxX[s], maxY[s], maxZ[s])}; }
 };
 static_assert(sizeof(Bvh4Node) == 128);
 
