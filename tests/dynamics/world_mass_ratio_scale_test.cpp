@@ -14,9 +14,12 @@
 #include "clod/bake.h"
 #include "clod/collision_body.h"
 #include "clod/contact_tree_builder.h"
+#include "clod/mass_properties.h"
+#include "clod/mesh_io.h"
 #include "clod/primitives.h"
 #include "clod/proximity.h"
 #include "clod/world.h"
+#include "support/test_paths.h"
 #include "support/test_scale.h"
 #include "world_test_support.h"
 
@@ -360,6 +363,48 @@ TEST(WorldMassRatio, SmallBoxesDroppedOnAnEdgeOrACornerNeverSinkPastOnePercent) 
         }
         EXPECT_LT(deepest, 0.01) << contactModelName(model) << " side " << side << " " << name;
       }
+}
+
+// A turned bunny-1500 of 1.3 cm dropped on the ground at 16 tests per frame and 60 Hz (a drop of
+// scripts/probe-random-scenes.py, seed 1402 at 1 cm): its lowest vertex never more than 1 % of
+// its diagonal below the ground's top at any frame (issue 17's criterion for drops). Oracle: the
+// mesh's vertices placed by the body's pose. Its fall takes ~50 substeps per frame and the budget
+// answers the pair every third, from the roots, without contacts; the skipped substeps hold the
+// pair where the bodies' boxes are apart. The mesh box turned with the bunny reached 4 mm below
+// its lowest vertex, so the boxes overlapped on every axis before it landed, nothing held it, and
+// it fell 1.41 % of its diagonal into the ground; the hold now uses the hulls' boxes
+// (docs/dynamics.md, "Pairs the budget has not reached"). Ten heights, as above.
+TEST(WorldMassRatio, ATurnedCentimetreBunnyDroppedAtSixteenTestsPerFrameNeverSinksPastOnePercent) {
+  const TriangleMesh mesh = loadMesh(std::string(CLOD_SHARED_MESH_DIR) + "/bunny-1500.obj").mesh;
+  static const auto shape = bakeShape(mesh);
+  const double scale = 0.013 / shape->diagonal();
+  const double diag = 0.013;
+  const MassProperties unit = computeMassPropertiesOrBoundingBox(mesh, 1000.0);
+  const Quat turn = Quat(0.9038871889888753, -0.3085577545052908, 0.2753540513993914, -0.10936273631536068).normalized();
+  double below = 0.0;  // the lowest vertex's depth below the mesh origin
+  for (const Vec3& v : mesh.vertices) below = std::max(below, -(turn * (scale * v)).z());
+  for (ContactModel model : models()) {
+    if (sanitizerRun() && model != ContactModel::kCfm) continue;
+    double deepest = 0.0;
+    for (int h = 1; h <= 10; ++h) {
+      World world = groundWorld(model, 16, 0.05);
+      RigidBodyDesc bunny;
+      bunny.shape = shape;
+      bunny.mass = unit.mass * scale * scale * scale;
+      bunny.inertia = unit.inertia * std::pow(scale, 5.0);
+      bunny.centerOfMass = scale * unit.centerOfMass;
+      bunny.position = Vec3(0.0, 0.0, below + 0.1 * h * diag);
+      bunny.orientation = turn;
+      const BodyId id = world.addBody(bunny, scale);
+      for (int s = 0; s < 30; ++s) {  // 0.5 s: lands within 0.1 s
+        world.step(1.0 / 60.0);
+        const RigidBodyState st = world.state(id);
+        for (const Vec3& v : mesh.vertices)
+          deepest = std::max(deepest, -(st.position + st.orientation * (scale * v)).z() / diag);
+      }
+    }
+    EXPECT_LT(deepest, 0.01) << contactModelName(model);
+  }
 }
 
 // A tower of five boxes ~0.4 m wide, each turned about the vertical, whose middle box is 50 times
