@@ -98,7 +98,8 @@ struct ContactPairEvent {
   /// The contacts the solver is about to use (world frame, contact.h): the narrow phase's answer of
   /// this substep as the persistent manifold kept it (docs/dynamics.md: a finer earlier manifold
   /// may stand, earlier points may be carried), or the pair's manifold when the budget skipped it
-  /// or manifold reuse spared it the query (PairReport::skipped / reused).
+  /// or manifold reuse spared it the query (PairReport::skipped / reused). The solver's holds at
+  /// the bodies' hull boxes (docs/dynamics.md, "Pairs the budget has not reached") are not listed.
   std::span<const Contact> contacts;
   std::uint32_t substep = 0;          ///< 0-based substep of the current World::step
 };
@@ -238,7 +239,7 @@ struct PairReport {
   /// held, so the finer manifold was kept (a finished answer always replaces it;
   /// docs/dynamics.md, "Graceful degradation").
   bool keptFiner = false;
-  std::uint32_t contacts = 0;  ///< contacts the solver used in the last substep
+  std::uint32_t contacts = 0;  ///< contacts the solver used in the last substep (not its holds, docs/dynamics.md)
 };
 
 /// What one World::step did.
@@ -289,7 +290,7 @@ struct StepReport {
   std::uint64_t solverContacts = 0;
   std::vector<PairReport> pairs;     ///< pairs with contacts or queries this step, sorted (a, b)
   std::vector<BodyId> leftBounds;    ///< bodies that left WorldSettings::bounds in this step
-  std::vector<Contact> contacts;     ///< last substep's contacts (world frame) ...
+  std::vector<Contact> contacts;     ///< last substep's contacts (world frame; not its holds) ...
   std::vector<std::array<BodyId, 2>> contactBodies;  ///< ... and the pair (a, b) of each
   /// ... and the two points of each that the solver holds apart, anchored in the bodies (world
   /// frame): [0] on A, [1] on B. A contact's separation is (point on A - point on B) . normal,

@@ -203,6 +203,7 @@ struct SolverContact {
   bool shockOnA = false;
   Vec3 frictionImpulse = Vec3::Zero();  // world-frame tangential impulse, for warm starting
   bool matched = false;                 // as a previous contact: already inherited by a new one
+  bool hold = false;                    // a hold at the bodies' hull boxes (holdAtBoxes), this substep only
 };
 
 struct PairState {
@@ -251,23 +252,52 @@ Aabb hullBox(const Body& b) {
   return box;
 }
 
-// A pair the test budget skipped this substep that holds no contacts -- none found yet, or its
-// last answer was empty and says nothing of this substep's motion -- is held where its bodies'
-// hull boxes (hullBox) are apart: the coarsest bound of the hierarchy, for no test. One
-// speculative contact along the axis on which the boxes are farthest apart, at the middle of
-// their overlap across it: the bodies may close that gap, not pass it, until a query answers the
-// pair. Without it such a pair was free: a pyramid of 1 mm boxes at 16 tests per frame has 26
-// pairs, a frame of free fall is 2.7 mm, and every box fell through the ground before its turn.
-// (Holding only the pairs no query had answered yet was not enough: boxes placed exactly on each
-// other got an empty first answer, then fell 5 % of a side while skipped.) The mesh boxes turned
-// with the bodies were used first: a turned bunny of 1.3 cm had its box's corner 4 mm below its
-// lowest vertex, the boxes overlapped on every axis before it landed, and with 16 tests per frame
-// answering it every third substep it fell 1.4 % of its diagonal into the floor unheld.
-// Boxes that overlap on every axis by more than kHoldOverlapRel of the smaller diagonal say
-// nothing (a body inside a bin's box, turned bodies whose boxes interlock): no hold. Returns
-// whether it added the contact.
+// The hull's point farthest along world direction `dir` (its support point), moved on by the
+// slack; the body's box centre where it has no hull.
+Vec3 hullSupport(const Body& b, const Vec3& dir) {
+  const CollisionBody& shape = *b.desc.shape;
+  std::span<const std::uint32_t> extreme = shape.spherePatchVertices(0);
+  double slack = 0.0;
+  if (extreme.empty()) {
+    extreme = shape.sphereSupportVertices(0);
+    slack = shape.sphereSupportSlack(0);
+  }
+  if (extreme.empty()) return b.worldBox(0.0).center();
+  const Vec3 local = b.q.conjugate() * dir;  // the direction in mesh coordinates
+  std::uint32_t best = extreme.front();
+  for (const std::uint32_t v : extreme)
+    if (local.dot(shape.mesh().vertices[v]) > local.dot(shape.mesh().vertices[best])) best = v;
+  return b.pose().apply(shape.mesh().vertices[best]) + slack * dir;
+}
+
+// A pair the test budget skipped this substep and whose contacts cannot speak for it -- it has
+// none (found none yet, or its last answer was empty), or they are an interrupted answer's, which
+// covers only the regions its coarse level reached -- is held where its bodies' hull boxes
+// (hullBox) are apart: the coarsest bound of the hierarchy, for no test. On the axis on which the
+// boxes are farthest apart, speculative contacts against the other box's face, each with its own
+// gap: the bodies may close them, not pass the face, until a query answers the pair.
+//   * A pair without contacts: one at the middle of the boxes' overlap, and one at each moving
+//     body's hull point nearest the face (its support point along the axis). Without a hold such
+//     a pair was free: a pyramid of 1 mm boxes at 16 tests per frame has 26 pairs, a frame of free
+//     fall is 2.7 mm, and every box fell through the ground before its turn. (Holding only the
+//     pairs no query had answered yet was not enough: boxes placed exactly on each other got an
+//     empty first answer, then fell 5 % of a side while skipped.) The middle alone let a box of a
+//     1 mm pile spinning at ~70 rad/s turn a corner through the face; its support point alone made
+//     a mesh landing on it pivot, and spot's and the bunny's drops ended 21-59 cm from the
+//     reference.
+//   * A pair with an interrupted answer's contacts (this substep's too): each moving body's
+//     support points along the axis and tilted from it by kHoldTilt toward the four sides -- the
+//     points it would pivot onto about the contacts it has. A bunny landing on one contact of its
+//     roots' answer turned about it and its other side came down 1.1 % of its diagonal into the
+//     floor before the next answer.
+// The boxes were the mesh boxes turned with the bodies first: a turned bunny of 1.3 cm had its
+// box's corner 4 mm below its lowest vertex, the boxes overlapped on every axis before it landed,
+// and it fell 1.4 % of its diagonal into the floor unheld. Boxes that overlap on every axis by
+// more than kHoldOverlapRel of the smaller diagonal say nothing (a body inside a bin's box,
+// turned bodies whose boxes interlock): no hold. Returns whether it added contacts.
 constexpr double kHoldOverlapRel = 0.01;
-bool holdAtBoxes(const Body& a, const Body& b, std::vector<SolverContact>& out) {
+constexpr double kHoldTilt = 0.25;  // tan of ~14 deg: a support point's tilt (alongside an answer)
+bool holdAtBoxes(const Body& a, const Body& b, bool alongside, std::vector<SolverContact>& out) {
   if (a.invMass == 0.0 && b.invMass == 0.0) return false;
   const Aabb ba = hullBox(a), bb = hullBox(b);
   int axis = 0;
@@ -283,21 +313,55 @@ bool holdAtBoxes(const Body& a, const Body& b, std::vector<SolverContact>& out) 
   }
   const double diag = std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal());
   if (!(gap >= -kHoldOverlapRel * diag)) return false;
-  Vec3 mid = 0.5 * (ba.min.cwiseMax(bb.min) + ba.max.cwiseMin(bb.max));  // across the axis
-  Vec3 onA = mid, onB = mid;
-  onA[axis] = aAbove ? ba.min[axis] : ba.max[axis];
-  onB[axis] = aAbove ? bb.max[axis] : bb.min[axis];
-  SolverContact cp;
-  cp.c.normal = Vec3::Unit(axis) * (aAbove ? 1.0 : -1.0);  // out of B toward A
-  cp.c.point = 0.5 * (onA + onB);
-  cp.c.depth = -gap;
-  // Boxes that overlap a little (bodies resting, or sunk within the slop) are held, not pushed.
-  cp.c.errorBound = std::max(0.0, -gap);
-  cp.c.featureKind = ContactFeature::kNone;
-  cp.anchorA = a.q.conjugate() * (onA - a.x);
-  cp.anchorB = b.q.conjugate() * (onB - b.x);
-  out.push_back(cp);
-  return true;
+  const std::size_t first = out.size();
+  const Vec3 n = Vec3::Unit(axis) * (aAbove ? 1.0 : -1.0);  // out of B toward A
+  const double faceA = aAbove ? ba.min[axis] : ba.max[axis];  // A's box face toward B
+  const double faceB = aAbove ? bb.max[axis] : bb.min[axis];  // B's box face toward A
+  // A contact between onA and onB, one of them on `face`'s box face. That face is there only
+  // within its box: a point past it (a box's corner past a table's edge) is not held, or the hold
+  // would be a table the box tips over onto.
+  auto hold = [&](const Vec3& onA, const Vec3& onB, const Aabb& face) {
+    for (const int k : {(axis + 1) % 3, (axis + 2) % 3})
+      if (onA[k] < face.min[k] || onA[k] > face.max[k]) return;
+    SolverContact cp;
+    cp.c.normal = n;
+    cp.c.point = 0.5 * (onA + onB);
+    cp.c.depth = (onB - onA).dot(n);
+    // Boxes that overlap a little (bodies resting, or sunk within the slop) are held, not pushed.
+    cp.c.errorBound = std::max(0.0, cp.c.depth);
+    cp.c.featureKind = ContactFeature::kNone;
+    cp.hold = true;
+    cp.anchorA = a.q.conjugate() * (onA - a.x);
+    cp.anchorB = b.q.conjugate() * (onB - b.x);
+    out.push_back(cp);
+  };
+  if (!alongside) {
+    Vec3 onA = 0.5 * (ba.min.cwiseMax(bb.min) + ba.max.cwiseMin(bb.max));  // across the axis
+    Vec3 onB = onA;
+    onA[axis] = faceA;
+    onB[axis] = faceB;
+    hold(onA, onB, bb);
+  }
+  // Each moving body's support point toward the other box's face (alongside an answer, also
+  // tilted toward the four sides).
+  const Vec3 u = Vec3::Unit((axis + 1) % 3), v = Vec3::Unit((axis + 2) % 3);
+  const Vec3 tilts[] = {Vec3::Zero(), kHoldTilt * u, -kHoldTilt * u, kHoldTilt * v, -kHoldTilt * v};
+  for (std::size_t k = 0; k < (alongside ? std::size(tilts) : 1); ++k) {
+    const Vec3& tilt = tilts[k];
+    if (a.invMass > 0.0) {
+      const Vec3 onA = hullSupport(a, tilt - n);
+      Vec3 onB = onA;
+      onB[axis] = faceB;
+      hold(onA, onB, bb);
+    }
+    if (b.invMass > 0.0) {
+      const Vec3 onB = hullSupport(b, tilt + n);
+      Vec3 onA = onB;
+      onA[axis] = faceA;
+      hold(onA, onB, ba);
+    }
+  }
+  return out.size() > first;
 }
 
 // One step of a two-axis dissipative constraint in the plane (u1, u2): an impulse against the
@@ -620,7 +684,8 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
 
   for (auto& [key, p] : pairs) {
     p.seen = false;
-    if (p.holding) p.contacts.clear();  // a hold lasts one substep; it is no answer to keep
+    if (p.holding)  // a hold lasts one substep; it is no answer to keep
+      std::erase_if(p.contacts, [](const SolverContact& c) { return c.hold; });
     p.holding = false;
   }
   order.clear();
@@ -685,7 +750,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       ++report.pairsSkipped;
       ++p->stale;
       --left;
-      if (p->contacts.empty()) p->holding = holdAtBoxes(a, bb, p->contacts);
+      if (p->contacts.empty() || p->interrupted) p->holding = holdAtBoxes(a, bb, !p->contacts.empty(), p->contacts);
     };
     // Proven apart (QueryResult::separation, proveApart): no query, no budget, no contacts.
     auto provenApart = [&] {
@@ -976,6 +1041,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
           if (cp.c.errorBound > 0.0) cp.c.normal = aSupports ? Vec3(-outOfSupport) : outOfSupport;
     }
     if (p->fresh) persistContacts(*p, a, b, diag);
+    if (p->fresh && p->interrupted && !p->contacts.empty()) p->holding = holdAtBoxes(a, b, true, p->contacts);
     double maxDepth = 0.0;
     double approach = 0.0;
     // A coarse contact (errorBound > 0: an interrupted sphere-model query) between a moving body
@@ -994,7 +1060,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       for (SolverContact& cp : p->contacts) {
         // The moving body is pushed along +n if it is A, along -n if it is B.
         const Vec3 push = aFixed ? Vec3(-cp.c.normal) : cp.c.normal;
-        if (cp.c.errorBound > 0.0 && length > 0.0 && push.dot(outward) < 0.0)
+        if (cp.c.errorBound > 0.0 && !cp.hold && length > 0.0 && push.dot(outward) < 0.0)
           cp.c.normal = (aFixed ? -1.0 : 1.0) * outward / length;
       }
     }
@@ -1833,12 +1899,15 @@ const StepReport& World::step(double dt) {
   }
   for (auto& [key, pr] : m.pairReports) {
     auto it = m.pairs.find(key);
-    pr.contacts = it == m.pairs.end() ? 0 : std::uint32_t(it->second.contacts.size());
+    pr.contacts = it == m.pairs.end() ? 0
+                                      : std::uint32_t(std::count_if(it->second.contacts.begin(), it->second.contacts.end(),
+                                                                    [](const SolverContact& c) { return !c.hold; }));
     pr.keptFiner = it != m.pairs.end() && it->second.keptFiner;
     m.report.pairs.push_back(pr);
   }
   for (auto& [p, ids] : m.order)
     for (const SolverContact& cp : p->contacts) {
+      if (cp.hold) continue;  // a bound the solver holds, no contact
       m.report.contacts.push_back(cp.c);
       m.report.contactBodies.push_back(ids);
       const Body& a = m.bodies[ids[0]];
@@ -2104,7 +2173,9 @@ void World::Impl::runContactCallback() {
   for (auto& [p, ids] : solveOrder) {
     if (p->contacts.empty()) continue;
     callbackContacts.clear();
-    for (const SolverContact& cp : p->contacts) callbackContacts.push_back(cp.c);
+    for (const SolverContact& cp : p->contacts)
+      if (!cp.hold) callbackContacts.push_back(cp.c);
+    if (callbackContacts.empty()) continue;  // holds only (holdAtBoxes): no contact to show
     const ContactPairEvent event{ids[0], ids[1], callbackContacts, substepIndex};
     if (contactCallback(event)) continue;
     const std::uint64_t key = pairKey(ids[0], ids[1]);
