@@ -131,6 +131,16 @@ struct Body {
   double minExtent = 0;  // smallest side of localBox
   double frameReach = 0; // farthest corner of localBox from the mesh origin (a turn's lever)
   std::uint32_t maxChildren = 0;  // the most children a sphere of its sphere-tree has
+  // The hull's world box and support points (holdAtBoxes) at the pose (x, q) they were found for:
+  // a body in many pairs finds them once per substep.
+  struct HullCache {
+    Vec3 x = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+    Quat q = Quat::Identity();
+    Aabb box;
+    std::array<std::uint8_t, 6> haveSupports{};         // how many, per axis direction (2 axis + (sign > 0))
+    std::array<std::array<Vec3, 5>, 6> supports;        // along it, and tilted (holdTilts)
+  };
+  mutable HullCache hull;
   // State: centre of mass in the world, orientation, velocities.
   Vec3 x = Vec3::Zero();
   Quat q = Quat::Identity();
@@ -232,50 +242,83 @@ struct PairState {
 
 std::uint64_t pairKey(BodyId a, BodyId b) { return (std::uint64_t(a) << 32) | b; }
 
-// A body's world box from its root patch's extreme vertices (CollisionBody::spherePatchVertices,
-// else sphereSupportVertices grown by their slack): its hull's box, whatever its turn. The mesh
-// box turned with the body reaches past the hull by up to its corners' lever.
-Aabb hullBox(const Body& b) {
-  const CollisionBody& shape = *b.desc.shape;
-  std::span<const std::uint32_t> extreme = shape.spherePatchVertices(0);
+// A body's hull: its root patch's extreme vertices (CollisionBody::spherePatchVertices, else
+// sphereSupportVertices, whose support is the hull's to within their slack).
+struct Hull {
+  std::span<const std::uint32_t> vertices;
   double slack = 0.0;
-  if (extreme.empty()) {
-    extreme = shape.sphereSupportVertices(0);
-    slack = shape.sphereSupportSlack(0);
-  }
-  if (extreme.empty()) return b.worldBox(0.0);
-  const Pose pose = b.pose();
-  Aabb box;
-  for (const std::uint32_t v : extreme) box.extend(pose.apply(shape.mesh().vertices[v]));
-  box.min.array() -= slack;
-  box.max.array() += slack;
-  return box;
+};
+Hull hullOf(const CollisionBody& shape) {
+  if (!shape.spherePatchVertices(0).empty()) return {shape.spherePatchVertices(0), 0.0};
+  return {shape.sphereSupportVertices(0), shape.sphereSupportSlack(0)};
 }
 
-// The hull's point farthest along world direction `dir` (its support point), moved on by the
-// slack; the body's box centre where it has no hull.
-Vec3 hullSupport(const Body& b, const Vec3& dir) {
-  const CollisionBody& shape = *b.desc.shape;
-  std::span<const std::uint32_t> extreme = shape.spherePatchVertices(0);
-  double slack = 0.0;
-  if (extreme.empty()) {
-    extreme = shape.sphereSupportVertices(0);
-    slack = shape.sphereSupportSlack(0);
+// A body's world box from its hull, grown by the slack: the hull's box whatever the body's turn,
+// where the mesh box turned with the body reaches past the hull by up to its corners' lever.
+const Aabb& hullBox(const Body& b) {
+  Body::HullCache& c = b.hull;
+  if (c.x == b.x && c.q.coeffs() == b.q.coeffs()) return c.box;
+  c.x = b.x;
+  c.q = b.q;
+  c.haveSupports.fill(0);
+  const Hull hull = hullOf(*b.desc.shape);
+  if (hull.vertices.empty()) return c.box = b.worldBox(0.0);
+  const Pose pose = b.pose();
+  const Mat3 r = pose.rotation.toRotationMatrix();
+  c.box = Aabb();
+  for (const std::uint32_t v : hull.vertices) c.box.extend(r * b.desc.shape->mesh().vertices[v]);
+  c.box.min += pose.translation;
+  c.box.max += pose.translation;
+  c.box.min.array() -= hull.slack;
+  c.box.max.array() += hull.slack;
+  return c.box;
+}
+
+// The hold's directions about a world axis: along it, and tilted by ~14 deg toward the four sides.
+constexpr double kHoldTilt = 0.25;  // tan of ~14 deg
+std::array<Vec3, 5> holdDirections(int axis, double sign) {
+  const Vec3 along = sign * Vec3::Unit(axis), u = Vec3::Unit((axis + 1) % 3), v = Vec3::Unit((axis + 2) % 3);
+  return {along, along + kHoldTilt * u, along - kHoldTilt * u, along + kHoldTilt * v, along - kHoldTilt * v};
+}
+
+// The hull's points farthest along the first `count` of holdDirections(axis, sign) (its support
+// points), moved on by the slack; the body's box centre where it has no hull. One pass over the
+// hull for all of them.
+const std::array<Vec3, 5>& hullSupports(const Body& b, int axis, double sign, std::size_t count) {
+  hullBox(b);  // the cache at this pose
+  Body::HullCache& c = b.hull;
+  const std::size_t slot = 2 * std::size_t(axis) + (sign > 0.0 ? 1 : 0);
+  std::array<Vec3, 5>& out = c.supports[slot];
+  if (c.haveSupports[slot] >= count) return out;
+  c.haveSupports[slot] = std::uint8_t(count);
+  const Hull hull = hullOf(*b.desc.shape);
+  if (hull.vertices.empty()) {
+    out.fill(c.box.center());
+    return out;
   }
-  if (extreme.empty()) return b.worldBox(0.0).center();
-  const Vec3 local = b.q.conjugate() * dir;  // the direction in mesh coordinates
-  std::uint32_t best = extreme.front();
-  for (const std::uint32_t v : extreme)
-    if (local.dot(shape.mesh().vertices[v]) > local.dot(shape.mesh().vertices[best])) best = v;
-  return b.pose().apply(shape.mesh().vertices[best]) + slack * dir;
+  const std::array<Vec3, 5> directions = holdDirections(axis, sign);
+  std::array<Vec3, 5> local;  // in mesh coordinates
+  for (std::size_t k = 0; k < 5; ++k) local[k] = b.q.conjugate() * directions[k];
+  const auto& vertices = b.desc.shape->mesh().vertices;
+  std::array<std::uint32_t, 5> best;
+  std::array<double, 5> reach;
+  best.fill(hull.vertices.front());
+  reach.fill(-std::numeric_limits<double>::infinity());
+  for (const std::uint32_t v : hull.vertices)
+    for (std::size_t k = 0; k < count; ++k)
+      if (const double d = local[k].dot(vertices[v]); d > reach[k]) reach[k] = d, best[k] = v;
+  const Pose pose = b.pose();
+  for (std::size_t k = 0; k < count; ++k) out[k] = pose.apply(vertices[best[k]]) + hull.slack * directions[k];
+  return out;
 }
 
 // A pair the test budget skipped this substep and whose contacts cannot speak for it -- it has
-// none (found none yet, or its last answer was empty), or they are an interrupted answer's, which
-// covers only the regions its coarse level reached -- is held where its bodies' hull boxes
-// (hullBox) are apart: the coarsest bound of the hierarchy, for no test. On the axis on which the
-// boxes are farthest apart, speculative contacts against the other box's face, each with its own
-// gap: the bodies may close them, not pass the face, until a query answers the pair.
+// none (found none yet, or its last answer was empty), or they are fewer than kHoldAlongsideBelow
+// points of an interrupted answer, which covers only the regions its coarse level reached and
+// which the body can turn about -- is held where its bodies' hull boxes (hullBox) are apart: the
+// coarsest bound of the hierarchy, for no test. On the axis on which the boxes are farthest
+// apart, speculative contacts against the other box's face, each with its own gap: the bodies
+// may close them, not pass the face, until a query answers the pair.
 //   * A pair without contacts: one at the middle of the boxes' overlap, and one at each moving
 //     body's hull point nearest the face (its support point along the axis). Without a hold such
 //     a pair was free: a pyramid of 1 mm boxes at 16 tests per frame has 26 pairs, a frame of free
@@ -285,21 +328,24 @@ Vec3 hullSupport(const Body& b, const Vec3& dir) {
 //     1 mm pile spinning at ~70 rad/s turn a corner through the face; its support point alone made
 //     a mesh landing on it pivot, and spot's and the bunny's drops ended 21-59 cm from the
 //     reference.
-//   * A pair with an interrupted answer's contacts (this substep's too): each moving body's
-//     support points along the axis and tilted from it by kHoldTilt toward the four sides -- the
-//     points it would pivot onto about the contacts it has. A bunny landing on one contact of its
-//     roots' answer turned about it and its other side came down 1.1 % of its diagonal into the
-//     floor before the next answer.
+//   * A pair with such an answer's contacts (this substep's too; `out` holds them): each moving
+//     body's support points along the axis and tilted from it by kHoldTilt toward the four sides
+//     -- the points it would pivot onto about the contacts it has. A bunny landing on one contact
+//     of its roots' answer turned about it and its other side came down 1.1 % of its diagonal
+//     into the floor before the next answer. (Three contacts span a support polygon; held beside
+//     them too, the 200-body bin at 1,024 tests per frame took 65 ms per frame against 36.)
+//   * Only points whose projection lies within the other box across the axis: its face is there
+//     only within it (a box's corner held past a table's edge stood on thin air).
 // The boxes were the mesh boxes turned with the bodies first: a turned bunny of 1.3 cm had its
 // box's corner 4 mm below its lowest vertex, the boxes overlapped on every axis before it landed,
 // and it fell 1.4 % of its diagonal into the floor unheld. Boxes that overlap on every axis by
 // more than kHoldOverlapRel of the smaller diagonal say nothing (a body inside a bin's box,
 // turned bodies whose boxes interlock): no hold. Returns whether it added contacts.
 constexpr double kHoldOverlapRel = 0.01;
-constexpr double kHoldTilt = 0.25;  // tan of ~14 deg: a support point's tilt (alongside an answer)
-bool holdAtBoxes(const Body& a, const Body& b, bool alongside, std::vector<SolverContact>& out) {
+constexpr std::size_t kHoldAlongsideBelow = 3;  // an answer with fewer contacts is held beside them
+bool holdAtBoxes(const Body& a, const Body& b, std::vector<SolverContact>& out) {
   if (a.invMass == 0.0 && b.invMass == 0.0) return false;
-  const Aabb ba = hullBox(a), bb = hullBox(b);
+  const Aabb &ba = hullBox(a), &bb = hullBox(b);
   int axis = 0;
   double gap = -std::numeric_limits<double>::infinity();
   bool aAbove = false;  // A's box lies on the + side of B's along `axis`
@@ -314,6 +360,7 @@ bool holdAtBoxes(const Body& a, const Body& b, bool alongside, std::vector<Solve
   const double diag = std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal());
   if (!(gap >= -kHoldOverlapRel * diag)) return false;
   const std::size_t first = out.size();
+  const bool alongside = !out.empty();
   const Vec3 n = Vec3::Unit(axis) * (aAbove ? 1.0 : -1.0);  // out of B toward A
   const double faceA = aAbove ? ba.min[axis] : ba.max[axis];  // A's box face toward B
   const double faceB = aAbove ? bb.max[axis] : bb.min[axis];  // B's box face toward A
@@ -344,21 +391,22 @@ bool holdAtBoxes(const Body& a, const Body& b, bool alongside, std::vector<Solve
   }
   // Each moving body's support point toward the other box's face (alongside an answer, also
   // tilted toward the four sides).
-  const Vec3 u = Vec3::Unit((axis + 1) % 3), v = Vec3::Unit((axis + 2) % 3);
-  const Vec3 tilts[] = {Vec3::Zero(), kHoldTilt * u, -kHoldTilt * u, kHoldTilt * v, -kHoldTilt * v};
-  for (std::size_t k = 0; k < (alongside ? std::size(tilts) : 1); ++k) {
-    const Vec3& tilt = tilts[k];
-    if (a.invMass > 0.0) {
-      const Vec3 onA = hullSupport(a, tilt - n);
-      Vec3 onB = onA;
+  const std::size_t directions = alongside ? 5 : 1;
+  const double sign = aAbove ? 1.0 : -1.0;  // n's sign along the axis
+  if (a.invMass > 0.0) {
+    const std::array<Vec3, 5>& supports = hullSupports(a, axis, -sign, directions);
+    for (std::size_t k = 0; k < directions; ++k) {
+      Vec3 onB = supports[k];
       onB[axis] = faceB;
-      hold(onA, onB, bb);
+      hold(supports[k], onB, bb);
     }
-    if (b.invMass > 0.0) {
-      const Vec3 onB = hullSupport(b, tilt + n);
-      Vec3 onA = onB;
+  }
+  if (b.invMass > 0.0) {
+    const std::array<Vec3, 5>& supports = hullSupports(b, axis, sign, directions);
+    for (std::size_t k = 0; k < directions; ++k) {
+      Vec3 onA = supports[k];
       onA[axis] = faceA;
-      hold(onA, onB, ba);
+      hold(onA, supports[k], ba);
     }
   }
   return out.size() > first;
@@ -750,7 +798,8 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       ++report.pairsSkipped;
       ++p->stale;
       --left;
-      if (p->contacts.empty() || p->interrupted) p->holding = holdAtBoxes(a, bb, !p->contacts.empty(), p->contacts);
+      if (p->contacts.empty() || (p->interrupted && p->contacts.size() < kHoldAlongsideBelow))
+        p->holding = holdAtBoxes(a, bb, p->contacts);
     };
     // Proven apart (QueryResult::separation, proveApart): no query, no budget, no contacts.
     auto provenApart = [&] {
@@ -1041,7 +1090,8 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
           if (cp.c.errorBound > 0.0) cp.c.normal = aSupports ? Vec3(-outOfSupport) : outOfSupport;
     }
     if (p->fresh) persistContacts(*p, a, b, diag);
-    if (p->fresh && p->interrupted && !p->contacts.empty()) p->holding = holdAtBoxes(a, b, true, p->contacts);
+    if (p->fresh && p->interrupted && !p->contacts.empty() && p->contacts.size() < kHoldAlongsideBelow)
+      p->holding = holdAtBoxes(a, b, p->contacts);
     double maxDepth = 0.0;
     double approach = 0.0;
     // A coarse contact (errorBound > 0: an interrupted sphere-model query) between a moving body
