@@ -313,9 +313,9 @@ const std::array<Vec3, 5>& hullSupports(const Body& b, int axis, double sign, st
 }
 
 // A pair the test budget skipped this substep and whose contacts cannot speak for it -- it has
-// none (found none yet, or its last answer was empty), or they are fewer than kHoldAlongsideBelow
-// points of an interrupted answer, which covers only the regions its coarse level reached and
-// which the body can turn about -- is held where its bodies' hull boxes (hullBox) are apart: the
+// none (found none yet, or its last answer was empty), or they are an interrupted answer's, which
+// covers only the regions its coarse level reached, and a moving body's centre of mass does not
+// rest within them (withinContacts) -- is held where its bodies' hull boxes (hullBox) are apart: the
 // coarsest bound of the hierarchy, for no test. On the axis on which the boxes are farthest
 // apart, speculative contacts against the other box's face, each with its own gap: the bodies
 // may close them, not pass the face, until a query answers the pair.
@@ -332,8 +332,9 @@ const std::array<Vec3, 5>& hullSupports(const Body& b, int axis, double sign, st
 //     body's support points along the axis and tilted from it by kHoldTilt toward the four sides
 //     -- the points it would pivot onto about the contacts it has. A bunny landing on one contact
 //     of its roots' answer turned about it and its other side came down 1.1 % of its diagonal
-//     into the floor before the next answer. (Three contacts span a support polygon; held beside
-//     them too, the 200-body bin at 1,024 tests per frame took 65 ms per frame against 36.)
+//     into the floor before the next answer. (Held beside every interrupted answer, the 200-body
+//     bin at 1,024 tests per frame took 65 ms per frame against 36; beside those of fewer than
+//     three contacts only, a 1 mm bunny turned off three contacts on one side of it.)
 //   * Only points whose projection lies within the other box across the axis: its face is there
 //     only within it (a box's corner held past a table's edge stood on thin air).
 // The boxes were the mesh boxes turned with the bodies first: a turned bunny of 1.3 cm had its
@@ -342,7 +343,37 @@ const std::array<Vec3, 5>& hullSupports(const Body& b, int axis, double sign, st
 // more than kHoldOverlapRel of the smaller diagonal say nothing (a body inside a bin's box,
 // turned bodies whose boxes interlock): no hold. Returns whether it added contacts.
 constexpr double kHoldOverlapRel = 0.01;
-constexpr std::size_t kHoldAlongsideBelow = 3;  // an answer with fewer contacts is held beside them
+
+// Whether `point`, seen along world axis `axis`, lies within the convex polygon of the contacts'
+// points: a centre of mass there rests on them and cannot turn off them.
+bool withinContacts(const std::vector<SolverContact>& contacts, const Vec3& point, int axis) {
+  const int i = (axis + 1) % 3, j = (axis + 2) % 3;
+  std::array<Eigen::Vector2d, 16> p;
+  std::size_t n = 0;
+  for (const SolverContact& c : contacts)
+    if (n < p.size()) p[n++] = Eigen::Vector2d(c.c.point[i], c.c.point[j]);
+  if (n < 3) return false;
+  std::sort(p.begin(), p.begin() + n, [](const auto& l, const auto& r) { return l.x() < r.x() || (l.x() == r.x() && l.y() < r.y()); });
+  auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
+  };
+  std::array<Eigen::Vector2d, 33> hull;  // Andrew's monotone chain, counter-clockwise
+  std::size_t k = 0;
+  for (std::size_t m = 0; m < n; ++m) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], p[m]) <= 0.0) --k;
+    hull[k++] = p[m];
+  }
+  for (std::size_t m = n - 1, lower = k + 1; m-- > 0;) {
+    while (k >= lower && cross(hull[k - 2], hull[k - 1], p[m]) <= 0.0) --k;
+    hull[k++] = p[m];
+  }
+  if (k < 4) return false;  // fewer than three corners: a point or a line
+  const Eigen::Vector2d c(point[i], point[j]);
+  for (std::size_t m = 0; m + 1 < k; ++m)
+    if (cross(hull[m], hull[m + 1], c) < 0.0) return false;
+  return true;
+}
+
 bool holdAtBoxes(const Body& a, const Body& b, std::vector<SolverContact>& out) {
   if (a.invMass == 0.0 && b.invMass == 0.0) return false;
   const Aabb &ba = hullBox(a), &bb = hullBox(b);
@@ -361,6 +392,10 @@ bool holdAtBoxes(const Body& a, const Body& b, std::vector<SolverContact>& out) 
   if (!(gap >= -kHoldOverlapRel * diag)) return false;
   const std::size_t first = out.size();
   const bool alongside = !out.empty();
+  // Beside contacts that every moving body's centre of mass rests within, no hold: they hold it.
+  if (alongside && (a.invMass == 0.0 || withinContacts(out, a.x, axis)) &&
+      (b.invMass == 0.0 || withinContacts(out, b.x, axis)))
+    return false;
   const Vec3 n = Vec3::Unit(axis) * (aAbove ? 1.0 : -1.0);  // out of B toward A
   const double faceA = aAbove ? ba.min[axis] : ba.max[axis];  // A's box face toward B
   const double faceB = aAbove ? bb.max[axis] : bb.min[axis];  // B's box face toward A
@@ -798,8 +833,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       ++report.pairsSkipped;
       ++p->stale;
       --left;
-      if (p->contacts.empty() || (p->interrupted && p->contacts.size() < kHoldAlongsideBelow))
-        p->holding = holdAtBoxes(a, bb, p->contacts);
+      if (p->contacts.empty() || p->interrupted) p->holding = holdAtBoxes(a, bb, p->contacts);
     };
     // Proven apart (QueryResult::separation, proveApart): no query, no budget, no contacts.
     auto provenApart = [&] {
@@ -1090,8 +1124,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
           if (cp.c.errorBound > 0.0) cp.c.normal = aSupports ? Vec3(-outOfSupport) : outOfSupport;
     }
     if (p->fresh) persistContacts(*p, a, b, diag);
-    if (p->fresh && p->interrupted && !p->contacts.empty() && p->contacts.size() < kHoldAlongsideBelow)
-      p->holding = holdAtBoxes(a, b, p->contacts);
+    if (p->fresh && p->interrupted && !p->contacts.empty()) p->holding = holdAtBoxes(a, b, p->contacts);
     double maxDepth = 0.0;
     double approach = 0.0;
     // A coarse contact (errorBound > 0: an interrupted sphere-model query) between a moving body
