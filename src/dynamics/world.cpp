@@ -137,8 +137,8 @@ struct Body {
     Vec3 x = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
     Quat q = Quat::Identity();
     Aabb box;
-    std::array<std::uint8_t, 6> haveSupports{};         // how many, per axis direction (2 axis + (sign > 0))
-    std::array<std::array<Vec3, 5>, 6> supports;        // along it, and tilted (holdTilts)
+    std::array<std::uint8_t, 6> haveSupports{};   // how many found, per direction 2 axis + (sign > 0)
+    std::array<std::array<Vec3, 5>, 6> supports;  // along holdDirections(axis, sign)
   };
   mutable HullCache hull;
   // State: centre of mass in the world, orientation, velocities.
