@@ -9,6 +9,7 @@
 #include <initializer_list>
 #include <limits>
 #include <map>
+#include <optional>
 
 #include <Eigen/Eigenvalues>
 
@@ -128,6 +129,10 @@ struct Body {
   Mat3 invInertiaLocal = Mat3::Zero();
   Vec3 comLocal = Vec3::Zero();
   Aabb localBox;         // mesh bounds, mesh coordinates
+  Aabb hullLocalBox;     // its hull's box (hullOf), grown by the slack, mesh coordinates
+  // A closed convex polyhedron's face planes n . x <= d (mesh coordinates; none for other bodies).
+  std::array<Eigen::Vector4d, CollisionBody::kMaxSphereFaceNormals> facePlanes;
+  std::uint32_t facePlaneCount = 0;
   double minExtent = 0;  // smallest side of localBox
   double frameReach = 0; // farthest corner of localBox from the mesh origin (a turn's lever)
   std::uint32_t maxChildren = 0;  // the most children a sphere of its sphere-tree has
@@ -225,6 +230,7 @@ struct PairState {
   TangentInverseMass rollingK;
   std::vector<SolverContact> contacts;
   std::vector<SolverContact> previous;
+  std::vector<SolverContact> heldBefore;  // last substep's holds: their impulses warm-start this one's
   std::uint32_t stale = 0;   // substeps since last query
   double priority = 0.0;
   bool seen = false;         // in this substep's broad phase
@@ -274,29 +280,97 @@ const Aabb& hullBox(const Body& b) {
   return c.box;
 }
 
-// The hold's directions about a world axis: along it, and tilted by ~14 deg toward the four sides.
+// The hull's box in mesh coordinates, grown by the slack: a body's box in its own frame.
+Aabb hullBoxInMesh(const CollisionBody& shape) {
+  const Hull hull = hullOf(shape);
+  if (hull.vertices.empty()) return shape.mesh().bounds();
+  Aabb box;
+  for (const std::uint32_t v : hull.vertices) box.extend(shape.mesh().vertices[v]);
+  box.min.array() -= hull.slack;
+  box.max.array() += hull.slack;
+  return box;
+}
+
+// A closed convex polyhedron's face planes (its root patch is the whole body, whose distinct face
+// normals and vertices it lists): n . x <= d, mesh coordinates. Returns their count, 0 for any
+// other body.
+std::uint32_t convexFacePlanes(const CollisionBody& shape, std::array<Eigen::Vector4d, CollisionBody::kMaxSphereFaceNormals>& out) {
+  if (!shape.patchIsWholeConvexBody(0)) return 0;
+  std::uint32_t count = 0;
+  for (const Vec3f& normal : shape.sphereFaceNormals(0)) {
+    const Vec3 n = normal.cast<double>();
+    double reach = -std::numeric_limits<double>::infinity();
+    for (const std::uint32_t v : shape.spherePatchVertices(0)) reach = std::max(reach, n.dot(shape.mesh().vertices[v]));
+    out[count++] = Eigen::Vector4d(n.x(), n.y(), n.z(), reach);
+  }
+  return count;
+}
+
+// The first point of a convex body (its facePlanes) on the world line from `from` along `dir`
+// (before `from` too: the body may reach past it); none where the line misses the body.
+std::optional<Vec3> firstPointAlong(const Body& b, const Vec3& from, const Vec3& dir) {
+  if (b.facePlaneCount == 0) return std::nullopt;
+  const Pose pose = b.pose();
+  const Vec3 p = pose.applyInverse(from), u = pose.rotation.conjugate() * dir;  // mesh coordinates
+  // A line along a side face (the support point was a corner on it) is inside that face within
+  // this much: a turn of 1e-4 rad otherwise made it enter through the side face high up.
+  const double grazing = 1e-3 * b.desc.shape->diagonal();
+  double enter = -std::numeric_limits<double>::infinity(), leave = std::numeric_limits<double>::infinity();
+  for (std::uint32_t k = 0; k < b.facePlaneCount; ++k) {
+    const Vec3 n = b.facePlanes[k].head<3>();
+    const double room = b.facePlanes[k].w() - n.dot(p), rate = n.dot(u);  // inside while s rate <= room
+    if (std::abs(rate) < 0.5) {  // a side face: the line is inside it or misses the body
+      if (room < -grazing) return std::nullopt;
+    } else if (rate < 0.0) {
+      enter = std::max(enter, room / rate);
+    } else {
+      leave = std::min(leave, room / rate);
+    }
+  }
+  if (!(enter <= leave) || !std::isfinite(enter)) return std::nullopt;
+  return from + enter * dir;
+}
+
+// The hull's box in the frame whose axes are the columns of `r` (coordinates r^T x): one pass.
+Aabb hullBoxAlong(const Body& b, const Mat3& r) {
+  const Pose pose = b.pose();
+  const Mat3 m = r.transpose() * pose.rotation.toRotationMatrix();
+  const Vec3 t = r.transpose() * pose.translation;
+  Aabb box;
+  const Hull hull = hullOf(*b.desc.shape);
+  if (hull.vertices.empty()) {
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 corner((k & 1) ? b.localBox.max.x() : b.localBox.min.x(), (k & 2) ? b.localBox.max.y() : b.localBox.min.y(),
+                        (k & 4) ? b.localBox.max.z() : b.localBox.min.z());
+      box.extend(m * corner + t);
+    }
+    return box;
+  }
+  for (const std::uint32_t v : hull.vertices) box.extend(m * b.desc.shape->mesh().vertices[v]);
+  box.min += t;
+  box.max += t;
+  box.min.array() -= hull.slack;
+  box.max.array() += hull.slack;
+  return box;
+}
+
+// The hold's directions about axis `axis` of the frame whose axes are r's columns: along it, and
+// tilted by ~14 deg toward the four sides.
 constexpr double kHoldTilt = 0.25;  // tan of ~14 deg
-std::array<Vec3, 5> holdDirections(int axis, double sign) {
-  const Vec3 along = sign * Vec3::Unit(axis), u = Vec3::Unit((axis + 1) % 3), v = Vec3::Unit((axis + 2) % 3);
+std::array<Vec3, 5> holdDirections(const Mat3& r, int axis, double sign) {
+  const Vec3 along = sign * r.col(axis), u = r.col((axis + 1) % 3), v = r.col((axis + 2) % 3);
   return {along, along + kHoldTilt * u, along - kHoldTilt * u, along + kHoldTilt * v, along - kHoldTilt * v};
 }
 
-// The hull's points farthest along the first `count` of holdDirections(axis, sign) (its support
-// points), moved on by the slack; the body's box centre where it has no hull. One pass over the
-// hull for all of them.
-const std::array<Vec3, 5>& hullSupports(const Body& b, int axis, double sign, std::size_t count) {
-  hullBox(b);  // the cache at this pose
-  Body::HullCache& c = b.hull;
-  const std::size_t slot = 2 * std::size_t(axis) + (sign > 0.0 ? 1 : 0);
-  std::array<Vec3, 5>& out = c.supports[slot];
-  if (c.haveSupports[slot] >= count) return out;
-  c.haveSupports[slot] = std::uint8_t(count);
+// The hull's points farthest along the first `count` world directions (its support points),
+// moved on by the slack; the body's box centre where it has no hull. One pass over the hull.
+std::array<Vec3, 5> supportPoints(const Body& b, const std::array<Vec3, 5>& directions, std::size_t count) {
+  std::array<Vec3, 5> out;
   const Hull hull = hullOf(*b.desc.shape);
   if (hull.vertices.empty()) {
-    out.fill(c.box.center());
+    out.fill(b.worldBox(0.0).center());
     return out;
   }
-  const std::array<Vec3, 5> directions = holdDirections(axis, sign);
   std::array<Vec3, 5> local;  // in mesh coordinates
   for (std::size_t k = 0; k < 5; ++k) local[k] = b.q.conjugate() * directions[k];
   const auto& vertices = b.desc.shape->mesh().vertices;
@@ -312,13 +386,25 @@ const std::array<Vec3, 5>& hullSupports(const Body& b, int axis, double sign, st
   return out;
 }
 
+// supportPoints along holdDirections about a world axis, cached at the body's pose.
+const std::array<Vec3, 5>& hullSupports(const Body& b, int axis, double sign, std::size_t count) {
+  hullBox(b);  // the cache at this pose
+  Body::HullCache& c = b.hull;
+  const std::size_t slot = 2 * std::size_t(axis) + (sign > 0.0 ? 1 : 0);
+  std::array<Vec3, 5>& out = c.supports[slot];
+  if (c.haveSupports[slot] >= count) return out;
+  c.haveSupports[slot] = std::uint8_t(count);
+  return out = supportPoints(b, holdDirections(Mat3::Identity(), axis, sign), count);
+}
+
 // A pair the test budget skipped this substep and whose contacts cannot speak for it -- it has
 // none (found none yet, or its last answer was empty), or they are an interrupted answer's, which
 // covers only the regions its coarse level reached, and a moving body's centre of mass does not
 // rest within them (withinContacts) -- is held where its bodies' hull boxes (hullBox) are apart: the
 // coarsest bound of the hierarchy, for no test. On the axis on which the boxes are farthest
-// apart, speculative contacts against the other box's face, each with its own gap: the bodies
-// may close them, not pass the face, until a query answers the pair.
+// apart (the world's, or a turned immovable body's own, chooseHoldFrame), speculative contacts
+// against the other box's face, each with its own gap: the bodies may close them, not pass the
+// face, until a query answers the pair.
 //   * A pair without contacts: one at the middle of the boxes' overlap, and one at each moving
 //     body's hull point nearest the face (its support point along the axis). Without a hold such
 //     a pair was free: a pyramid of 1 mm boxes at 16 tests per frame has 26 pairs, a frame of free
@@ -336,7 +422,9 @@ const std::array<Vec3, 5>& hullSupports(const Body& b, int axis, double sign, st
 //     bin at 1,024 tests per frame took 65 ms per frame against 36; beside those of fewer than
 //     three contacts only, a 1 mm bunny turned off three contacts on one side of it.)
 //   * Only points whose projection lies within the other box across the axis: its face is there
-//     only within it (a box's corner held past a table's edge stood on thin air).
+//     only within it (a box's corner held past a table's edge stood on thin air). A point past it
+//     moves onto the face's nearest point, the table's edge, where the body's surface above it is
+//     known (a convex body's face planes).
 // The boxes were the mesh boxes turned with the bodies first: a turned bunny of 1.3 cm had its
 // box's corner 4 mm below its lowest vertex, the boxes overlapped on every axis before it landed,
 // and it fell 1.4 % of its diagonal into the floor unheld. Boxes that overlap on every axis by
@@ -344,14 +432,14 @@ const std::array<Vec3, 5>& hullSupports(const Body& b, int axis, double sign, st
 // turned bodies whose boxes interlock): no hold. Returns whether it added contacts.
 constexpr double kHoldOverlapRel = 0.01;
 
-// Whether `point`, seen along world axis `axis`, lies within the convex polygon of the contacts'
+// Whether `point`, seen along axis `axis` of the frame whose axes are `frame`'s columns, lies within the convex polygon of the contacts'
 // points: a centre of mass there rests on them and cannot turn off them.
-bool withinContacts(const std::vector<SolverContact>& contacts, const Vec3& point, int axis) {
-  const int i = (axis + 1) % 3, j = (axis + 2) % 3;
+bool withinContacts(const std::vector<SolverContact>& contacts, const Vec3& point, const Mat3& frame, int axis) {
+  const Vec3 u = frame.col((axis + 1) % 3), w = frame.col((axis + 2) % 3);
   std::array<Eigen::Vector2d, 16> p;
   std::size_t n = 0;
   for (const SolverContact& c : contacts)
-    if (n < p.size()) p[n++] = Eigen::Vector2d(c.c.point[i], c.c.point[j]);
+    if (n < p.size()) p[n++] = Eigen::Vector2d(u.dot(c.c.point), w.dot(c.c.point));
   if (n < 3) return false;
   std::sort(p.begin(), p.begin() + n, [](const auto& l, const auto& r) { return l.x() < r.x() || (l.x() == r.x() && l.y() < r.y()); });
   auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
@@ -368,53 +456,103 @@ bool withinContacts(const std::vector<SolverContact>& contacts, const Vec3& poin
     hull[k++] = p[m];
   }
   if (k < 4) return false;  // fewer than three corners: a point or a line
-  const Eigen::Vector2d c(point[i], point[j]);
+  const Eigen::Vector2d c(u.dot(point), w.dot(point));
   for (std::size_t m = 0; m + 1 < k; ++m)
     if (cross(hull[m], hull[m + 1], c) < 0.0) return false;
   return true;
 }
 
-bool holdAtBoxes(const Body& a, const Body& b, std::vector<SolverContact>& out) {
-  if (a.invMass == 0.0 && b.invMass == 0.0) return false;
-  const Aabb &ba = hullBox(a), &bb = hullBox(b);
+// The hulls' boxes in one frame (coordinates r^T x), the axis on which they are farthest apart
+// and by how much (< 0: they overlap on every axis), and whether A's lies on its + side.
+struct HoldFrame {
+  Mat3 r = Mat3::Identity();
+  Aabb a, b;
   int axis = 0;
   double gap = -std::numeric_limits<double>::infinity();
-  bool aAbove = false;  // A's box lies on the + side of B's along `axis`
+  bool aAbove = false;
+};
+HoldFrame holdFrame(const Mat3& r, const Aabb& a, const Aabb& b) {
+  HoldFrame f{r, a, b};
   for (int k = 0; k < 3; ++k) {
-    const double above = ba.min[k] - bb.max[k], below = bb.min[k] - ba.max[k];
-    if (std::max(above, below) > gap) {
-      gap = std::max(above, below);
-      axis = k;
-      aAbove = above >= below;
+    const double above = a.min[k] - b.max[k], below = b.min[k] - a.max[k];
+    if (std::max(above, below) > f.gap) {
+      f.gap = std::max(above, below);
+      f.axis = k;
+      f.aAbove = above >= below;
     }
   }
+  return f;
+}
+
+// Whether a rotation's axes are the world's, up to order and sign (its frame finds what the
+// world's does).
+bool alongWorldAxes(const Quat& q) {
+  const Mat3 r = q.toRotationMatrix();
+  for (int k = 0; k < 3; ++k)
+    if (r.col(k).cwiseAbs().maxCoeff() < 1.0 - 1e-9) return false;
+  return true;
+}
+
+// The frame of the pair's hold: the world's axes with the cached hull boxes; where those overlap
+// on every axis, a turned immovable body's own axes, in which its box is its hull's (a slope's
+// face, a tilted wall's), if they find a wider gap. (A slope's world box holds whatever rests on
+// it, so a small box sliding down a slope at 16 tests per frame was never held, turned off its
+// roots' one contact and went through. A moving body's own axes were tried too: they held the
+// boxes of a 1 mm pile in turned frames that turn with them, and one of them was pressed 40 % of
+// its diagonal into the ground, seed 1404's pile, where the world's axes had held it.)
+HoldFrame chooseHoldFrame(const Body& a, const Body& b, double overlapAllowed) {
+  HoldFrame best = holdFrame(Mat3::Identity(), hullBox(a), hullBox(b));
+  if (best.gap >= -overlapAllowed) return best;
+  for (const Body* own : {&b, &a}) {
+    if (own->invMass > 0.0 || alongWorldAxes(own->q)) continue;
+    const Pose pose = own->pose();
+    const Mat3 r = pose.rotation.toRotationMatrix();
+    Aabb mine = own->hullLocalBox;
+    mine.min += r.transpose() * pose.translation;
+    mine.max += r.transpose() * pose.translation;
+    const Aabb other = hullBoxAlong(own == &a ? b : a, r);
+    const HoldFrame f = own == &a ? holdFrame(r, mine, other) : holdFrame(r, other, mine);
+    if (f.gap > best.gap) best = f;
+  }
+  return best;
+}
+
+bool holdAtBoxes(const Body& a, const Body& b, std::vector<SolverContact>& out) {
+  if (a.invMass == 0.0 && b.invMass == 0.0) return false;
   const double diag = std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal());
-  if (!(gap >= -kHoldOverlapRel * diag)) return false;
+  const HoldFrame f = chooseHoldFrame(a, b, kHoldOverlapRel * diag);
+  if (!(f.gap >= -kHoldOverlapRel * diag)) return false;
+  const int axis = f.axis;
+  const Aabb &ba = f.a, &bb = f.b;  // in frame coordinates
   const std::size_t first = out.size();
   const bool alongside = !out.empty();
   // Beside contacts that every moving body's centre of mass rests within, no hold: they hold it.
-  if (alongside && (a.invMass == 0.0 || withinContacts(out, a.x, axis)) &&
-      (b.invMass == 0.0 || withinContacts(out, b.x, axis)))
+  if (alongside && (a.invMass == 0.0 || withinContacts(out, a.x, f.r, axis)) &&
+      (b.invMass == 0.0 || withinContacts(out, b.x, f.r, axis)))
     return false;
-  const Vec3 n = Vec3::Unit(axis) * (aAbove ? 1.0 : -1.0);  // out of B toward A
-  const double faceA = aAbove ? ba.min[axis] : ba.max[axis];  // A's box face toward B
-  const double faceB = aAbove ? bb.max[axis] : bb.min[axis];  // B's box face toward A
-  // A contact between onA and onB, one of them on `face`'s box face. That face is there only
-  // within its box: a point past it (a box's corner past a table's edge) is not held, or the hold
-  // would be a table the box tips over onto.
+  const double sign = f.aAbove ? 1.0 : -1.0;  // the normal's sign along the axis
+  const Vec3 n = sign * f.r.col(axis);         // out of B toward A, in the world
+  const double faceA = f.aAbove ? ba.min[axis] : ba.max[axis];  // A's box face toward B
+  const double faceB = f.aAbove ? bb.max[axis] : bb.min[axis];  // B's box face toward A
+  // A contact between onA and onB (frame coordinates), one of them on `face`'s box face. That
+  // face is there only within its box: a point past it (a box's corner past a table's edge) is
+  // not held, or the hold would be a table the box tips over onto.
   auto hold = [&](const Vec3& onA, const Vec3& onB, const Aabb& face) {
     for (const int k : {(axis + 1) % 3, (axis + 2) % 3})
       if (onA[k] < face.min[k] || onA[k] > face.max[k]) return;
+    const Vec3 worldA = f.r * onA, worldB = f.r * onB;
+    for (std::size_t k = first; k < out.size(); ++k)  // the same point found along two directions
+      if ((out[k].c.point - 0.5 * (worldA + worldB)).squaredNorm() <= 1e-18 * diag * diag) return;
     SolverContact cp;
     cp.c.normal = n;
-    cp.c.point = 0.5 * (onA + onB);
-    cp.c.depth = (onB - onA).dot(n);
+    cp.c.point = 0.5 * (worldA + worldB);
+    cp.c.depth = (worldB - worldA).dot(n);
     // Boxes that overlap a little (bodies resting, or sunk within the slop) are held, not pushed.
     cp.c.errorBound = std::max(0.0, cp.c.depth);
     cp.c.featureKind = ContactFeature::kNone;
     cp.hold = true;
-    cp.anchorA = a.q.conjugate() * (onA - a.x);
-    cp.anchorB = b.q.conjugate() * (onB - b.x);
+    cp.anchorA = a.q.conjugate() * (worldA - a.x);
+    cp.anchorB = b.q.conjugate() * (worldB - b.x);
     out.push_back(cp);
   };
   if (!alongside) {
@@ -427,24 +565,72 @@ bool holdAtBoxes(const Body& a, const Body& b, std::vector<SolverContact>& out) 
   // Each moving body's support point toward the other box's face (alongside an answer, also
   // tilted toward the four sides).
   const std::size_t directions = alongside ? 5 : 1;
-  const double sign = aAbove ? 1.0 : -1.0;  // n's sign along the axis
+  const bool worldFrame = f.r == Mat3::Identity();
+  auto supportsOf = [&](const Body& body, double toward) {
+    return worldFrame ? hullSupports(body, axis, toward, directions)
+                      : supportPoints(body, holdDirections(f.r, axis, toward), directions);
+  };
+  // A support point past the other box's face across the axis is moved onto the face's nearest
+  // point, and the body's surface above it taken where it is known (a convex body's face planes):
+  // there the face ends, at the edge a box overhanging a table's pivots on. (The hull's corner
+  // past the edge says nothing: a box turning off a coarse contact inside the edge, with its
+  // centre of mass between that contact and the edge, fell off the table.)
+  auto onFaceOf = [&](const Body& body, const Vec3& support, const Aabb& face, const Vec3& toward) -> std::optional<Vec3> {
+    Vec3 p = f.r.transpose() * support;
+    bool past = false;
+    for (const int k : {(axis + 1) % 3, (axis + 2) % 3}) {
+      const double inside = std::clamp(p[k], face.min[k], face.max[k]);
+      past = past || inside != p[k];
+      p[k] = inside;
+    }
+    if (!past) return p;
+    const std::optional<Vec3> surface = firstPointAlong(body, f.r * p, toward);
+    if (!surface) return std::nullopt;
+    return f.r.transpose() * *surface;
+  };
   if (a.invMass > 0.0) {
-    const std::array<Vec3, 5>& supports = hullSupports(a, axis, -sign, directions);
+    const std::array<Vec3, 5> supports = supportsOf(a, -sign);
     for (std::size_t k = 0; k < directions; ++k) {
-      Vec3 onB = supports[k];
+      const std::optional<Vec3> onA = onFaceOf(a, supports[k], bb, n);
+      if (!onA) continue;
+      Vec3 onB = *onA;
       onB[axis] = faceB;
-      hold(supports[k], onB, bb);
+      hold(*onA, onB, bb);
     }
   }
   if (b.invMass > 0.0) {
-    const std::array<Vec3, 5>& supports = hullSupports(b, axis, sign, directions);
+    const std::array<Vec3, 5> supports = supportsOf(b, sign);
     for (std::size_t k = 0; k < directions; ++k) {
-      Vec3 onA = supports[k];
+      const std::optional<Vec3> onB = onFaceOf(b, supports[k], ba, -n);
+      if (!onB) continue;
+      Vec3 onA = *onB;
       onA[axis] = faceA;
-      hold(onA, supports[k], ba);
+      hold(onA, *onB, ba);
     }
   }
   return out.size() > first;
+}
+
+// holdAtBoxes for a pair, each new hold warm-started with the impulses of last substep's hold at
+// its point. A hold lives one substep; without them a box at rest over a table's edge, whose
+// coarse contacts (warm-started) lie inside the edge and whose centre of mass lies beyond them,
+// met its edge hold at zero impulse every substep, and the iterations left it turning outward a
+// little each time until it fell.
+bool holdPair(PairState& p, const Body& a, const Body& b) {
+  const std::size_t first = p.contacts.size();
+  if (!holdAtBoxes(a, b, p.contacts)) return false;
+  const double near = 1e-3 * std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal());
+  for (std::size_t k = first; k < p.contacts.size(); ++k) {
+    SolverContact& cp = p.contacts[k];
+    for (SolverContact& old : p.heldBefore)
+      if (!old.matched && old.c.normal.dot(cp.c.normal) > 0.999 && (old.c.point - cp.c.point).squaredNorm() <= near * near) {
+        old.matched = true;
+        cp.lambdaN = old.lambdaN;
+        cp.frictionImpulse = old.frictionImpulse;
+        break;
+      }
+  }
+  return true;
 }
 
 // One step of a two-axis dissipative constraint in the plane (u1, u2): an impulse against the
@@ -673,6 +859,8 @@ BodyId World::addBody(const RigidBodyDesc& d) {
   b.desc.orientation = b.q;
   b.x = d.position + b.q * b.comLocal;
   b.localBox = d.shape->mesh().bounds();
+  b.hullLocalBox = hullBoxInMesh(*d.shape);
+  b.facePlaneCount = convexFacePlanes(*d.shape, b.facePlanes);
   b.minExtent = b.localBox.extent().minCoeff();
   b.frameReach = b.localBox.min.cwiseAbs().cwiseMax(b.localBox.max.cwiseAbs()).norm();
   for (std::uint32_t n : d.shape->sphereTree().childCount) b.maxChildren = std::max(b.maxChildren, n);
@@ -767,8 +955,15 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
 
   for (auto& [key, p] : pairs) {
     p.seen = false;
-    if (p.holding)  // a hold lasts one substep; it is no answer to keep
+    p.heldBefore.clear();
+    if (p.holding) {  // a hold lasts one substep; it is no answer to keep
+      for (const SolverContact& c : p.contacts)
+        if (c.hold) {
+          p.heldBefore.push_back(c);
+          p.heldBefore.back().matched = false;
+        }
       std::erase_if(p.contacts, [](const SolverContact& c) { return c.hold; });
+    }
     p.holding = false;
   }
   order.clear();
@@ -833,7 +1028,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       ++report.pairsSkipped;
       ++p->stale;
       --left;
-      if (p->contacts.empty() || p->interrupted) p->holding = holdAtBoxes(a, bb, p->contacts);
+      if (p->contacts.empty() || p->interrupted) p->holding = holdPair(*p, a, bb);
     };
     // Proven apart (QueryResult::separation, proveApart): no query, no budget, no contacts.
     auto provenApart = [&] {
@@ -953,6 +1148,10 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       ++report.pairsReused;
       p->stale = 0;
       --left;
+      // An interrupted answer carried on is held as when it was fresh (prepare): a box at rest over
+      // a table's edge on its roots' contacts, held the substep they came and not the next, turned
+      // off them and fell.
+      if (p->interrupted && !p->contacts.empty()) p->holding = holdPair(*p, a, bb);
       continue;
     }
     // Under a time budget a pair without contacts may be arriving (an empty answer, finished or
@@ -1124,7 +1323,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
           if (cp.c.errorBound > 0.0) cp.c.normal = aSupports ? Vec3(-outOfSupport) : outOfSupport;
     }
     if (p->fresh) persistContacts(*p, a, b, diag);
-    if (p->fresh && p->interrupted && !p->contacts.empty()) p->holding = holdAtBoxes(a, b, p->contacts);
+    if (p->fresh && p->interrupted && !p->contacts.empty()) p->holding = holdPair(*p, a, b);
     double maxDepth = 0.0;
     double approach = 0.0;
     // A coarse contact (errorBound > 0: an interrupted sphere-model query) between a moving body

@@ -307,17 +307,16 @@ TEST(WorldMassRatio, AMillimetrePyramidStandsWhileSixteenTestsPerFrameReachItsPa
 // than follow them, so their contacts take the supporting body's face direction as the
 // interrupted ones do (docs/dynamics.md): a box sliding at 2 sqrt(side) m/s failed to slide its
 // distance or tilted 1.5-4 deg, at every size. At 16 tests per frame a pair borrows from the
-// step's later substeps the tests one expansion of its front needs. Left out: 1 mm at 16 tests.
-// Its step has 128 substeps (the first-contact rule: gravity alone moves a 1 mm box 1.6
-// diagonals per 60 Hz frame), an eighth of a test each, and the slide's first frame runs on the
-// roots' one D&O contact, which friction tips (23 deg; cfm, exact and the contact tree answer two
-// boxes by the separating-axis test at any budget).
+// step's later substeps the tests one expansion of its front needs. At 1 mm and 16 tests a step
+// has 128 substeps (the first-contact rule: gravity alone moves a 1 mm box 1.6 diagonals per
+// 60 Hz frame), an eighth of a test each, and the slide's first frame runs on the roots' one D&O
+// contact, which friction tipped 23 deg until such a pair was held at its hull boxes beside it
+// (docs/dynamics.md, "Pairs the budget has not reached").
 TEST(WorldMassRatio, SphereModelsRestStackAndSlideFromOneMillimetreToOneHundredMetres) {
   for (double side : {0.001, 0.01, 1.0, 10.0, 100.0})
     for (ContactModel model : {ContactModel::kDos, ContactModel::kAverage})
       for (std::uint64_t budget : {std::uint64_t(16), std::uint64_t(0)}) {
         if (sanitizerRun() && side != 0.001 && side != 100.0) continue;
-        if (side == 0.001 && budget == 16) continue;
         expectBoxScenesAlike(model, budget, side);
       }
 }
@@ -461,6 +460,53 @@ TEST(WorldMassRatio, ASpinningBoxOfAMillimetrePileIsHeldAboveTheGroundWhileItsPa
     }
     EXPECT_LT(deepest, 0.01) << contactModelName(model);
   }
+}
+
+// A 5 mm cube sliding down a slab turned 40 deg (mu 0.5, below tan 40 deg = 0.84) with every
+// model at 16 tests per frame and unlimited: after 0.25 s it has slid a t^2 / 2 with
+// a = g (sin 40 - mu cos 40) (analytic; within 10 %, issue 17's criterion), keeps its face on
+// the slope and never sinks 1 % of its diagonal into it. The slab's world box holds the cube
+// whatever it does, so before a pair the budget interrupted was held only in the world's axes,
+// never: with dos and average the cube turned off its roots' one contact and went through the
+// slope within 0.12 s. Holds now try the turned body's own axes where the world's find no gap
+// (docs/dynamics.md, "Pairs the budget has not reached").
+TEST(WorldMassRatio, ACentimetreCubeSlidesDownASlopeWithEveryModelAtSixteenTestsPerFrame) {
+  constexpr double kSide = 0.005, kSlope = 40.0 * M_PI / 180.0, kMu = 0.5, kTime = 0.25;
+  const Quat turn(Eigen::AngleAxisd(kSlope, Vec3::UnitY()));  // the slope falls toward +x
+  const Vec3 up = turn * Vec3::UnitZ(), down = turn * Vec3::UnitX();
+  const auto slab = bakeShape(makeBox(Vec3(0.08, 0.015, 0.0025)));
+  for (ContactModel model : {ContactModel::kCfm, ContactModel::kExact, ContactModel::kContactTree, ContactModel::kDos,
+                             ContactModel::kAverage})
+    for (std::uint64_t budget : {std::uint64_t(16), std::uint64_t(0)}) {
+      if (sanitizerRun() && budget == 0) continue;
+      // Centred at the origin: its top face through 0.0025 up.
+      World world = test::staticGroundWorld(model, budget, slab, Vec3::Zero(), turn, kMu);
+      const double mass = 1000.0 * kSide * kSide * kSide;
+      RigidBodyDesc d = cubeAt(kSide, mass, -0.05 * down + (0.0025 + 0.5 * kSide) * up);
+      d.shape = bakeShape(makeBox(Vec3::Constant(0.5 * kSide)));
+      d.orientation = turn;
+      d.friction = kMu;
+      const BodyId id = world.addBody(d);
+      double deepest = 0.0;  // below the slope's face, in the cube's diagonals
+      const int steps = int(std::lround(kTime * 60.0));
+      for (int s = 0; s < steps; ++s) {
+        world.step(1.0 / 60.0);
+        const RigidBodyState st = world.state(id);
+        for (int c = 0; c < 8; ++c) {
+          const Vec3 corner(c & 1 ? 1.0 : -1.0, c & 2 ? 1.0 : -1.0, c & 4 ? 1.0 : -1.0);
+          const double height = (st.position + st.orientation * (0.5 * kSide * corner)).dot(up) - 0.0025;
+          deepest = std::max(deepest, -height / (std::sqrt(3.0) * kSide));
+        }
+      }
+      const RigidBodyState st = world.state(id);
+      const double expected = 0.5 * 9.81 * (std::sin(kSlope) - kMu * std::cos(kSlope)) * kTime * kTime;
+      const std::string what = std::string(contactModelName(model)) + " at " + std::to_string(budget);
+      EXPECT_NEAR((st.position - d.position).dot(down), expected, 0.1 * expected) << what;
+      EXPECT_LT(deepest, 0.01) << what;
+      // Its face on the slope: the cube's axes still the slope's (within 2 deg, issue 17's slide).
+      const Vec3 faceUp = st.orientation * Vec3::UnitZ();
+      EXPECT_LT(std::acos(std::clamp(faceUp.dot(up), -1.0, 1.0)) * 180.0 / M_PI, 2.0) << what;
+    }
 }
 
 // A tower of five boxes ~0.4 m wide, each turned about the vertical, whose middle box is 50 times

@@ -12,6 +12,7 @@
 #include "clod/contact_tree_builder.h"
 #include "clod/primitives.h"
 #include "clod/proximity.h"
+#include "clod/world.h"
 #include "narrowphase/separation.h"
 
 namespace clod::test {
@@ -55,6 +56,24 @@ inline double tiltDegrees(const Quat& q) {
 inline const std::shared_ptr<const CollisionBody>& unitWorldCube() {
   static const std::shared_ptr<const CollisionBody> shape = bakeWorldShape(makeBox(Vec3(0.5, 0.5, 0.5)));
   return shape;
+}
+
+/// A world of `model` at `budget` tests per frame (0: unlimited) holding one static body, the
+/// ground: `shape` scaled by `scale` (World::addBody), placed at `position` turned by `turn`.
+inline World staticGroundWorld(ContactModel model, std::uint64_t budget, std::shared_ptr<const CollisionBody> shape,
+                               const Vec3& position, const Quat& turn, double friction, double scale = 1.0) {
+  WorldSettings ws;
+  ws.model = model;
+  ws.budgetTests = budget;
+  World world(ws);
+  RigidBodyDesc ground;
+  ground.type = BodyType::kStatic;
+  ground.shape = std::move(shape);
+  ground.position = position;
+  ground.orientation = turn;
+  ground.friction = friction;
+  world.addBody(ground, scale);
+  return world;
 }
 
 }  // namespace clod::test
