@@ -1148,10 +1148,12 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       ++report.pairsReused;
       p->stale = 0;
       --left;
-      // An interrupted answer carried on is held as when it was fresh (prepare): a box at rest over
-      // a table's edge on its roots' contacts, held the substep they came and not the next, turned
-      // off them and fell.
-      if (p->interrupted && !p->contacts.empty()) p->holding = holdPair(*p, a, bb);
+      // An interrupted answer carried on against an immovable body is held as when it was fresh
+      // (prepare): a box at rest over a table's edge on its roots' contacts, held the substep they
+      // came and not the next, turned off them and fell. (Between two moving bodies too, the
+      // 200-body bin at 1,024 tests per frame took ~10 % longer per frame.)
+      if (p->interrupted && !p->contacts.empty() && (a.invMass == 0.0 || bb.invMass == 0.0))
+        p->holding = holdPair(*p, a, bb);
       continue;
     }
     // Under a time budget a pair without contacts may be arriving (an empty answer, finished or
