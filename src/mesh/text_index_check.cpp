@@ -167,6 +167,37 @@ std::optional<std::string> findJsonDepthProblem(std::string_view json, std::uint
 
 bool looksLikeCollada(std::string_view text) { return text.find("<COLLADA") != std::string_view::npos; }
 
+namespace {
+
+// A Collada array's `count` attribute against the number of values it holds: Assimp 5.2.5 sizes
+// the array by `count` and its accessors then read an empty one (a <float_array> without
+// `count`, or with count 0, -1 or "abc", crashed its Collada reader: fuzz_mesh_load).
+std::optional<std::string> arrayCountProblem(std::string_view name, std::size_t at, std::string_view attributes,
+                                             std::size_t values) {
+  const std::string where = "Collada <" + std::string(name) + "> at byte " + std::to_string(at);
+  std::size_t key = attributes.find("count");
+  while (key != std::string_view::npos && key > 0 && !std::isspace(static_cast<unsigned char>(attributes[key - 1])))
+    key = attributes.find("count", key + 1);
+  if (key == std::string_view::npos) return where + " has no count attribute";
+  std::size_t k = key + 5;
+  while (k < attributes.size() && std::isspace(static_cast<unsigned char>(attributes[k]))) ++k;
+  if (k >= attributes.size() || attributes[k] != '=') return where + " has no count attribute";
+  ++k;
+  while (k < attributes.size() && std::isspace(static_cast<unsigned char>(attributes[k]))) ++k;
+  const char quote = k < attributes.size() ? attributes[k] : '\0';
+  const std::size_t close = quote == '"' || quote == '\'' ? attributes.find(quote, k + 1) : std::string_view::npos;
+  const std::string_view digits = close == std::string_view::npos ? std::string_view() : attributes.substr(k + 1, close - k - 1);
+  const bool number = !digits.empty() && digits.size() <= 18 &&
+                      std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; });
+  if (!number) return where + " has a count that is not a whole number";
+  const std::size_t count = std::stoull(std::string(digits));
+  if (count == 0 || count != values)
+    return where + " says count=\"" + std::string(digits) + "\" but holds " + std::to_string(values) + " values";
+  return std::nullopt;
+}
+
+}  // namespace
+
 std::optional<std::string> findColladaNumberListProblem(std::string_view text) {
   if (!looksLikeCollada(text)) return std::nullopt;
   static constexpr std::string_view kLists[] = {"p", "vcount", "v", "h", "int_array", "float_array"};
@@ -186,15 +217,26 @@ std::optional<std::string> findColladaNumberListProblem(std::string_view text) {
       continue;
     const std::size_t tagEnd = text.find('>', nameEnd);
     if (tagEnd == std::string_view::npos) return std::nullopt;  // truncated: Assimp's verdict
-    if (text[tagEnd - 1] == '/') continue;                      // an empty element
+    const bool array = name.ends_with("_array");
+    if (text[tagEnd - 1] == '/') {  // an empty element
+      if (array) return arrayCountProblem(name, at, text.substr(nameEnd, tagEnd - nameEnd), 0);
+      continue;
+    }
     const bool real = name == "float_array";
+    std::size_t values = 0;
+    bool inValue = false;
     for (std::size_t k = tagEnd + 1; k < text.size() && text[k] != '<'; ++k) {
       if (!numberChar(text[k], real)) {
         return "Collada <" + std::string(name) + "> at byte " + std::to_string(at) +
                " holds a character that is not part of a number (byte " + std::to_string(k) + ", code " +
                std::to_string(static_cast<unsigned char>(text[k])) + ")";
       }
+      const bool space = std::isspace(static_cast<unsigned char>(text[k])) != 0;
+      values += !space && !inValue;
+      inValue = !space;
     }
+    if (array)
+      if (auto problem = arrayCountProblem(name, at, text.substr(nameEnd, tagEnd - nameEnd), values)) return problem;
   }
   return std::nullopt;
 }

@@ -60,7 +60,10 @@ bool looksLikeCollada(std::string_view text);
 /// written with (digits, whitespace, '-'; in `<float_array>` also '+', '.', 'e', 'E'), naming
 /// the element and the byte; nullopt
 /// otherwise. Assimp 5.2.5's Collada reader never returns on such a list (fuzz_mesh_load:
-/// one byte of box_z_up.dae's `<p>` changed). O(size).
+/// one byte of box_z_up.dae's `<p>` changed). Also a message when an `<int_array>` or
+/// `<float_array>` has no `count` attribute, or one that is not the number of values it holds
+/// (0 included): Assimp sizes the array by it, and an accessor reading an array sized 0 crashed
+/// (fuzz_mesh_load: `count` misspelt). O(size).
 std::optional<std::string> findColladaNumberListProblem(std::string_view text);
 
 }  // namespace clod::detail

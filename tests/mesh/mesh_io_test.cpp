@@ -226,6 +226,9 @@ TEST(LoadMesh, EveryBadFileGivesItsErrorCodeAndNamesTheCulprit) {
       // box_z_up.dae with one index of its <p> turned into a letter: Assimp 5.2.5's Collada reader
       // never returns (found by fuzz_mesh_load with a byte 0xc9 there).
       {"collada_letter_in_index_list.dae", ErrorCode::kParseError, "Collada <p> at byte 1710"},
+      // box_z_up.dae whose <float_array> lost its count attribute ("ciunt"): Assimp 5.2.5 sized the
+      // array 0 and its accessor read through a null pointer (found by fuzz_mesh_load).
+      {"collada_array_without_count.dae", ErrorCode::kParseError, "Collada <float_array> at byte 981 has no count attribute"},
   };
   for (const BadCase& c : cases) {
     SCOPED_TRACE(c.file);
@@ -255,6 +258,30 @@ TEST(LoadMesh, PlyContentIsCheckedWhateverTheExtension) {
     EXPECT_EQ(thrown.code, ErrorCode::kParseError);
     EXPECT_NE(thrown.message.find("end_header"), std::string::npos) << thrown.message;
   }
+}
+
+TEST(LoadMesh, ColladaArraysMustHoldTheValuesTheirCountSays) {
+  // Oracle: box_z_up.dae's positions hold 24 numbers. Assimp 5.2.5 sizes an array by its count
+  // and crashed on 0, -1 and "abc" (an empty array its accessor reads); every other mismatch is
+  // a malformed file all the same.
+  const std::string good = readBytes(goodFile("box_z_up.dae"));
+  const std::string attribute = "count=\"24\">-5";
+  ASSERT_NE(good.find(attribute), std::string::npos);
+  EXPECT_NO_THROW(loadMeshFromMemory(asBytes(good), "dae"));
+  for (const char* count : {"0", "-1", "abc", "", "20", "30", "99999999999"}) {
+    SCOPED_TRACE(count);
+    std::string dae = good;
+    dae.replace(dae.find(attribute), attribute.size(), "count=\"" + std::string(count) + "\">-5");
+    const Thrown thrown = thrownBy([&] { loadMeshFromMemory(asBytes(dae), "dae"); });
+    EXPECT_EQ(thrown.code, ErrorCode::kParseError);
+    EXPECT_NE(thrown.message.find("Collada <float_array>"), std::string::npos) << thrown.message;
+  }
+  std::string emptied = good;  // no values at all, count 0: its accessor still reads it
+  const std::size_t from = emptied.find(attribute), to = emptied.find("</float_array>", from);
+  emptied.replace(from, to - from, "count=\"0\">");
+  const Thrown thrown = thrownBy([&] { loadMeshFromMemory(asBytes(emptied), "dae"); });
+  EXPECT_EQ(thrown.code, ErrorCode::kParseError);
+  EXPECT_NE(thrown.message.find("count=\"0\" but holds 0 values"), std::string::npos) << thrown.message;
 }
 
 TEST(LoadMesh, ColladaContentIsCheckedWhateverTheExtension) {
