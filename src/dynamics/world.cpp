@@ -259,36 +259,35 @@ Hull hullOf(const CollisionBody& shape) {
   return {shape.sphereSupportVertices(0), shape.sphereSupportSlack(0)};
 }
 
-// A body's world box from its hull, grown by the slack: the hull's box whatever the body's turn,
-// where the mesh box turned with the body reaches past the hull by up to its corners' lever.
+// The box of a shape's hull under x -> m x + t, grown by the slack (nullopt: it has no hull).
+std::optional<Aabb> hullBoxUnder(const CollisionBody& shape, const Mat3& m, const Vec3& t) {
+  const Hull hull = hullOf(shape);
+  if (hull.vertices.empty()) return std::nullopt;
+  Aabb box;
+  for (const std::uint32_t v : hull.vertices) box.extend(m * shape.mesh().vertices[v]);
+  box.min += t;
+  box.max += t;
+  box.min.array() -= hull.slack;
+  box.max.array() += hull.slack;
+  return box;
+}
+
+// A body's world box from its hull: the hull's box whatever the body's turn, where the mesh box
+// turned with the body reaches past the hull by up to its corners' lever.
 const Aabb& hullBox(const Body& b) {
   Body::HullCache& c = b.hull;
   if (c.x == b.x && c.q.coeffs() == b.q.coeffs()) return c.box;
   c.x = b.x;
   c.q = b.q;
   c.haveSupports.fill(0);
-  const Hull hull = hullOf(*b.desc.shape);
-  if (hull.vertices.empty()) return c.box = b.worldBox(0.0);
   const Pose pose = b.pose();
-  const Mat3 r = pose.rotation.toRotationMatrix();
-  c.box = Aabb();
-  for (const std::uint32_t v : hull.vertices) c.box.extend(r * b.desc.shape->mesh().vertices[v]);
-  c.box.min += pose.translation;
-  c.box.max += pose.translation;
-  c.box.min.array() -= hull.slack;
-  c.box.max.array() += hull.slack;
-  return c.box;
+  const std::optional<Aabb> box = hullBoxUnder(*b.desc.shape, pose.rotation.toRotationMatrix(), pose.translation);
+  return c.box = box ? *box : b.worldBox(0.0);
 }
 
-// The hull's box in mesh coordinates, grown by the slack: a body's box in its own frame.
+// The hull's box in mesh coordinates: a body's box in its own frame.
 Aabb hullBoxInMesh(const CollisionBody& shape) {
-  const Hull hull = hullOf(shape);
-  if (hull.vertices.empty()) return shape.mesh().bounds();
-  Aabb box;
-  for (const std::uint32_t v : hull.vertices) box.extend(shape.mesh().vertices[v]);
-  box.min.array() -= hull.slack;
-  box.max.array() += hull.slack;
-  return box;
+  return hullBoxUnder(shape, Mat3::Identity(), Vec3::Zero()).value_or(shape.mesh().bounds());
 }
 
 // A closed convex polyhedron's face planes (its root patch is the whole body, whose distinct face
@@ -336,21 +335,13 @@ Aabb hullBoxAlong(const Body& b, const Mat3& r) {
   const Pose pose = b.pose();
   const Mat3 m = r.transpose() * pose.rotation.toRotationMatrix();
   const Vec3 t = r.transpose() * pose.translation;
-  Aabb box;
-  const Hull hull = hullOf(*b.desc.shape);
-  if (hull.vertices.empty()) {
-    for (int k = 0; k < 8; ++k) {
-      const Vec3 corner((k & 1) ? b.localBox.max.x() : b.localBox.min.x(), (k & 2) ? b.localBox.max.y() : b.localBox.min.y(),
-                        (k & 4) ? b.localBox.max.z() : b.localBox.min.z());
-      box.extend(m * corner + t);
-    }
-    return box;
+  if (std::optional<Aabb> box = hullBoxUnder(*b.desc.shape, m, t)) return *box;
+  Aabb box;  // the mesh box's corners
+  for (int k = 0; k < 8; ++k) {
+    const Vec3 corner((k & 1) ? b.localBox.max.x() : b.localBox.min.x(), (k & 2) ? b.localBox.max.y() : b.localBox.min.y(),
+                      (k & 4) ? b.localBox.max.z() : b.localBox.min.z());
+    box.extend(m * corner + t);
   }
-  for (const std::uint32_t v : hull.vertices) box.extend(m * b.desc.shape->mesh().vertices[v]);
-  box.min += t;
-  box.max += t;
-  box.min.array() -= hull.slack;
-  box.max.array() += hull.slack;
   return box;
 }
 
@@ -432,8 +423,9 @@ const std::array<Vec3, 5>& hullSupports(const Body& b, int axis, double sign, st
 // turned bodies whose boxes interlock): no hold. Returns whether it added contacts.
 constexpr double kHoldOverlapRel = 0.01;
 
-// Whether `point`, seen along axis `axis` of the frame whose axes are `frame`'s columns, lies within the convex polygon of the contacts'
-// points: a centre of mass there rests on them and cannot turn off them.
+// Whether `point`, seen along axis `axis` of the frame whose axes are `frame`'s columns, lies
+// within the convex polygon of the contacts' points: a centre of mass there rests on them and
+// cannot turn off them.
 bool withinContacts(const std::vector<SolverContact>& contacts, const Vec3& point, const Mat3& frame, int axis) {
   const Vec3 u = frame.col((axis + 1) % 3), w = frame.col((axis + 2) % 3);
   std::array<Eigen::Vector2d, 16> p;
