@@ -1371,34 +1371,66 @@ bool vertexOnFaceContacts(const PatchSide& patch, const PatchSide& faceted, cons
   return out.size() > before;
 }
 
-// Along the segment from `from` to `to` projected along n onto the plane of `triangles` (one
-// plane, normal n; `from` over one of them), the parameter in [0, 1] where it first leaves their
-// union: 1 when it never does. Each triangle covers an interval of the parameter (three
-// half-lines); the union is followed from 0.
-double leavesTrianglesAt(const TriangleMesh& mesh, std::span<const std::uint32_t> triangles, const Vec3& n,
-                         const Vec3& from, const Vec3& to) {
-  double reach = 0.0;
-  for (bool grew = true; grew && reach < 1.0;) {
-    grew = false;
-    for (std::uint32_t t : triangles) {
-      double lo = 0.0, hi = 1.0;
-      for (int k = 0; k < 3; ++k) {
-        const Vec3 a = mesh.corner(t, k), b = mesh.corner(t, (k + 1) % 3);
-        const double g0 = n.dot((b - a).cross(from - a)), g1 = n.dot((b - a).cross(to - a));
-        // g(s) = g0 + s (g1 - g0) >= 0 on the triangle's side of edge ab.
-        if (g1 == g0) {
-          if (g0 < 0.0) hi = -1.0;
-        } else if (g1 > g0) {
-          lo = std::max(lo, -g0 / (g1 - g0));
-        } else {
-          hi = std::min(hi, -g0 / (g1 - g0));
-        }
-      }
-      if (lo <= reach + 1e-12 && hi > reach + 1e-12) {
-        reach = hi;
-        grew = true;
-      }
+// The parameter interval [lo, hi] of the segment from `from` to `to`, projected along n, over
+// triangle t (three half-lines); empty when hi < lo.
+std::pair<double, double> segmentOverTriangle(const TriangleMesh& mesh, std::uint32_t t, const Vec3& n,
+                                              const Vec3& from, const Vec3& to) {
+  double lo = 0.0, hi = 1.0;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 a = mesh.corner(t, k), b = mesh.corner(t, (k + 1) % 3);
+    const double g0 = n.dot((b - a).cross(from - a)), g1 = n.dot((b - a).cross(to - a));
+    // g(s) = g0 + s (g1 - g0) >= 0 on the triangle's side of edge ab.
+    if (g1 == g0) {
+      if (g0 < 0.0) hi = -1.0;
+    } else if (g1 > g0) {
+      lo = std::max(lo, -g0 / (g1 - g0));
+    } else {
+      hi = std::min(hi, -g0 / (g1 - g0));
     }
+  }
+  return {lo, hi};
+}
+
+// Along the segment from `from` to `to` projected along n onto the plane (normal n, offset
+// n . x = offset) of `triangles` (`from` over one of them), the parameter in [0, 1] where it
+// first leaves the body's flat surface there: 1 when it never does. The surface is the union of
+// `triangles` and the triangles connected to them across edges in the same plane that the
+// segment passes over -- a floor's pieces are the sphere-tree's leaves, and the rim a box
+// overhangs may lie in another leaf than the corner over the floor: stopping at the leaf's own
+// border put the crossing inside the floor, where it holds nothing up. At most kMaxWalk
+// triangles are followed; beyond them the crossing comes early (still a point of the overlap).
+double leavesFlatSurfaceAt(const CollisionBody& body, std::span<const std::uint32_t> triangles, const Vec3& n,
+                           double offset, double tolerance, const Vec3& from, const Vec3& to) {
+  constexpr std::size_t kMaxWalk = 256;
+  struct Over {
+    std::uint32_t triangle;
+    double lo, hi;
+  };
+  thread_local std::vector<Over> over;  // scratch: no allocation per query once warm
+  over.clear();
+  const TriangleMesh& mesh = body.mesh();
+  auto visit = [&](std::uint32_t t) {
+    if (over.size() >= kMaxWalk) return;
+    for (const Over& o : over)
+      if (o.triangle == t) return;
+    const auto [lo, hi] = segmentOverTriangle(mesh, t, n, from, to);
+    // Touching (a segment through a shared vertex) counts: the walk goes on through it.
+    if (hi >= lo - 1e-12) over.push_back({t, lo, hi});
+  };
+  for (std::uint32_t t : triangles) visit(t);
+  auto inPlane = [&](std::uint32_t t) {
+    return mesh.triangleNormal(t).dot(n) > 1.0 - 1e-9 && std::abs(n.dot(mesh.corner(t, 0)) - offset) <= tolerance;
+  };
+  for (std::size_t i = 0; i < over.size(); ++i)  // breadth first over the surface the segment crosses
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t next = body.triangleNeighbour(over[i].triangle, k);
+      if (next != CollisionBody::kNoNeighbour && inPlane(next)) visit(next);
+    }
+  std::sort(over.begin(), over.end(), [](const Over& x, const Over& y) { return x.lo < y.lo; });
+  double reach = 0.0;
+  for (const Over& o : over) {
+    if (o.lo > reach + 1e-12) break;
+    reach = std::max(reach, o.hi);
   }
   return std::min(reach, 1.0);
 }
@@ -1422,6 +1454,7 @@ bool cornersOverFlatPatchContacts(const PatchSide& flat, const PatchSide& other,
   if (triangles.empty()) return false;
   const double offsetLocal = nLocal.dot(mesh.corner(triangles[0], 0));
   const double tolerance = 1e-9 * (flat.body.diagonal() + other.body.diagonal());
+  const double planeTolerance = 1e-7 * flat.body.diagonal();  // a floor's pieces written to 9 digits are one plane
   const std::size_t before = out.size();
   auto addContact = [&](const Vec3& v, double depth) {
     Contact ci = c;
@@ -1466,7 +1499,8 @@ bool cornersOverFlatPatchContacts(const PatchSide& flat, const PatchSide& other,
     if (!behind[i].over) continue;
     for (std::size_t j = 0; j < count; ++j) {
       if (behind[j].over) continue;
-      const double leaves = leavesTrianglesAt(mesh, triangles, nLocal, behind[i].local, behind[j].local);
+      const double leaves = leavesFlatSurfaceAt(flat.body, triangles, nLocal, offsetLocal, planeTolerance,
+                                                behind[i].local, behind[j].local);
       if (!(leaves < 1.0)) continue;
       addContact(behind[i].v + leaves * (behind[j].v - behind[i].v),
                  (1.0 - leaves) * behind[i].depth + leaves * behind[j].depth);
@@ -2568,7 +2602,12 @@ bool exactContacts(const CollisionBody& bodyA, const CollisionBody& bodyB, const
     const std::uint32_t patch = s.patchParent[kc.pair];
     if (s.patchHasVertices[patch] != 0) {
       const double depth = lineThrough(bodyA, bodyB, bFromA, s.patchNormal[patch], kc.contact);
-      if (depth > patchTol && depth <= s.patchVertexDepth[patch] + patchTol) {
+      // A patch whose vertices are in by rounding only (a box standing on a floor, 1e-19 to 1e-9)
+      // has its crossings touching as well, the line through them finding no depth: dropped as
+      // grazing, a thin box over a floor's rim kept its inner corners only and toppled sideways
+      // (exact, unlimited budget). There the crossings are contacts at the depth they have.
+      const bool resting = s.patchVertexDepth[patch] <= patchTol;
+      if ((depth > patchTol || resting) && depth <= s.patchVertexDepth[patch] + patchTol) {
         // A point of the intersection curve that the line along the normal finds inside both
         // bodies: where a box standing over an edge of the other body crosses it, a corner of
         // their overlap that is no body's vertex (with the vertices alone the box turned about

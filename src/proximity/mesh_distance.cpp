@@ -117,6 +117,9 @@ struct MeshDistance::Impl {
   std::vector<std::uint32_t> triangleOf; // BVH position -> mesh triangle
   std::vector<detail::WindingFarField> farFields;  // per node slot: node * 4 + slot
   SignMethod signMethod = SignMethod::kWindingNumber;
+  // A sheet signed by its pseudonormals (sheetPseudonormals): its border vertices, where points
+  // beyond the border are outside (beyondSheetBorder). Empty otherwise.
+  std::vector<std::uint8_t> borderVertex;
 
   struct Nearest {
     TrianglePoint point;
@@ -126,6 +129,7 @@ struct MeshDistance::Impl {
   double windingSolidAngle(const Vec3& p) const;
   ClosestPoint toClosestPoint(const Vec3& p, const TrianglePoint& tp, std::uint32_t triangle) const;
   void buildFarFields(double beta);
+  bool beyondSheetBorder(const Vec3& p, const ClosestPoint& closest) const;
 };
 
 namespace {
@@ -350,6 +354,35 @@ MeshDistance::MeshDistance(TriangleMesh mesh, const MeshDistanceSettings& settin
       consistentlyOriented(m, *impl.topology, settings.sheetPseudonormals) && verticesManifold(m, *impl.topology);
   impl.signMethod = pseudonormalsValid && !settings.forceWindingNumber ? SignMethod::kPseudonormal
                                                                        : SignMethod::kWindingNumber;
+  if (impl.signMethod == SignMethod::kPseudonormal && !impl.topology->closed()) {
+    impl.borderVertex.assign(m.vertices.size(), 0);
+    for (std::uint32_t e = 0; e < impl.topology->edgeCount(); ++e) {
+      if (impl.topology->edgeTriangles(e).size() != 1) continue;
+      impl.borderVertex[impl.topology->edges()[e].v0] = 1;
+      impl.borderVertex[impl.topology->edges()[e].v1] = 1;
+    }
+  }
+}
+
+// For a sheet: p's closest point is on the border and p lies beyond it (off the line along the
+// feature's normal through it), not behind the sheet. The solid a user means by a floor or a
+// terrain is what lies behind its faces -- below its footprint. Signed by the side of the plane
+// alone, the points just under the plane beyond a floor quad's edge read inside, as deep as they
+// were far from the edge: a box standing over the edge was pushed back 10 % of its size, and one
+// falling past the edge would be caught there (docs/contact-tree.md, "Sheets").
+bool MeshDistance::Impl::beyondSheetBorder(const Vec3& p, const ClosestPoint& closest) const {
+  if (borderVertex.empty()) return false;
+  bool border = false;
+  switch (closest.feature.type) {
+    case FeatureType::kFace: return false;
+    case FeatureType::kEdge: border = topology->edgeTriangles(closest.feature.index).size() == 1; break;
+    case FeatureType::kVertex: border = borderVertex[closest.feature.index] != 0; break;
+  }
+  if (!border) return false;
+  const Vec3 off = p - closest.point;
+  const Vec3 across = off - off.dot(closest.normal) * closest.normal;
+  // 1e-6 of the distance: a point straight behind the border (on the solid's wall) stays inside.
+  return across.squaredNorm() > 1e-12 * off.squaredNorm();
 }
 
 MeshDistance::~MeshDistance() = default;
@@ -374,7 +407,7 @@ MeshDistance::Signed MeshDistance::signedQuery(const Vec3& p) const {
   bool inside;
   const double side = (p - out.closest.point).dot(out.closest.normal);
   if (impl_->signMethod == SignMethod::kPseudonormal && side != 0.0) {
-    inside = side < 0.0;
+    inside = side < 0.0 && !impl_->beyondSheetBorder(p, out.closest);
   } else {
     // Winding numbers for open meshes, and as the fallback where a degenerate feature has no
     // pseudonormal (zero normal) to decide with.

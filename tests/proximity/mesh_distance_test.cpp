@@ -503,8 +503,9 @@ namespace clod {
 namespace {
 
 // A sheet (an open mesh that encloses nothing: a floor quad, a terrain) signed by its
-// pseudonormals with MeshDistanceSettings::sheetPseudonormals: behind it is inside. Oracle: the
-// analytic distance to the plane over the footprint, signed by the side. Long thin triangles (a
+// pseudonormals with MeshDistanceSettings::sheetPseudonormals: behind it is inside, beyond its
+// border outside. Oracle: the analytic distance to the plane over the footprint, signed by the
+// side; beyond it the distance to the rectangle. Long thin triangles (a
 // 13.7 x 3 m quad in two) included: a box on such a floor read -0.669 at 0.669 above it.
 TEST(MeshDistanceSheet, QuadIsSignedByItsSideOverItsFootprint) {
   for (double hx : {1.0, 6.86}) {
@@ -520,6 +521,14 @@ TEST(MeshDistanceSheet, QuadIsSignedByItsSideOverItsFootprint) {
       const Vec3 p(u(rng) * hx, u(rng) * hy, z + h(rng));
       // 1e-12 of the quad's size: rounding of the closest point.
       EXPECT_NEAR(sheet.signedDistance(p), p.z() - z, 1e-12 * hx) << p.transpose();
+    }
+    // Beyond the border the solid behind the sheet ends: outside, at the distance to the quad
+    // (oracle: the point's offset from the rectangle, clamped per axis), under the plane too.
+    for (int i = 0; i < 2000; ++i) {
+      const Vec3 p(u(rng) * 2.0 * hx, u(rng) * 2.0 * hy, z + h(rng));
+      const Vec3 beyond(std::max(std::abs(p.x()) - hx, 0.0), std::max(std::abs(p.y()) - hy, 0.0), p.z() - z);
+      if (beyond.x() == 0.0 && beyond.y() == 0.0) continue;  // over the footprint: above
+      EXPECT_NEAR(sheet.signedDistance(p), beyond.norm(), 1e-12 * hx) << p.transpose();
     }
   }
 }
