@@ -79,6 +79,18 @@ TEST(EdgeOverhang, BoxOverATwoTriangleFloorsEdgeGetsItsOverlapsCorners) {
                        box);
 }
 
+// A floor of 0.5 m squares (8 x 8 m, an octree of 1 m leaves): the box's inner corners lie over
+// the leaf next to the one holding the floor's edge. The crossing followed the inner corner's
+// leaf only and stopped at its border, 1 m inside the edge, and the overlap's corners on the edge
+// got no contact (cfm; exact where it falls back to it).
+TEST(EdgeOverhang, BoxOverATessellatedFloorsEdgeGetsItsOverlapsCornersFromAnotherLeaf) {
+  static const CollisionBody floor = test::octreeBodyForCfm(test::makeFloorGrid(4.0, 4.0, 16));
+  static const CollisionBody box = test::octreeBodyForCfm(makeBox(Vec3(0.6, kHalf, kHalf)));
+  // Over the edge x = -4 by 0.1: x in [-4.1, -2.9], y in [0.3, 0.8] (between grid lines).
+  expectOverlapCorners({"over a grid floor's edge", &floor, Vec3(-3.5, 0.55, 0.0), {Eigen::Vector2d(-4.0, 0.3), Eigen::Vector2d(-2.9, 0.3), Eigen::Vector2d(-4.0, 0.8), Eigen::Vector2d(-2.9, 0.8)}},
+                       box);
+}
+
 TEST(EdgeOverhang, BoxOverTheEndOfAClosedBodysFloorGetsItsOverlapsCorners) {
   // The L's floor: x in [-2, 1] in front of its wall, y in [-2, 2], top z = 0 (l_shaped_body.h).
   static const CollisionBody l = test::octreeBodyForCfm(test::makeLShapedBody());
