@@ -25,6 +25,12 @@ constexpr double kHalf = 0.25;  // the box's half side
 
 using test::tiltDegrees;
 
+// A solid box of half sides (a, b, c): m (b^2 + c^2) / 3 about x, and so on.
+Mat3 solidBoxInertia(const Vec3& half, double mass) {
+  const Vec3 sq = half.cwiseProduct(half);
+  return Vec3(sq.y() + sq.z(), sq.x() + sq.z(), sq.x() + sq.y()).asDiagonal() * (mass / 3.0);
+}
+
 struct Support {
   const char* name;
   TriangleMesh mesh;
@@ -109,11 +115,7 @@ TEST(EdgeOverhangWorld, ATallBoxOverASlabsEndStandsWithEveryModelAndBudget) {
         RigidBodyDesc d;
         d.shape = box;
         d.mass = 150.0 * scale * scale * scale;  // water: 0.3 x 0.5 x 1 m^3 at 1 m
-        // A solid box: m (b^2 + c^2) / 3 with half sides b, c.
-        d.inertia = Vec3(half.y() * half.y() + half.z() * half.z(), half.x() * half.x() + half.z() * half.z(),
-                         half.x() * half.x() + half.y() * half.y())
-                        .asDiagonal() *
-                    (d.mass * scale * scale / 3.0);
+        d.inertia = solidBoxInertia(scale * half, d.mass);
         d.friction = 0.6;
         d.position = scale * Vec3(-2.0 + 0.04, -0.3, half.z());  // 11 cm past the end (at 1 m)
         const BodyId id = world.addBody(d, scale);
@@ -150,10 +152,7 @@ TEST(EdgeOverhangWorld, AThinBoxOverATessellatedFloorsEdgeStandsWithEveryModel) 
         RigidBodyDesc d;
         d.shape = box;
         d.mass = 8.0 * half.prod() * 1000.0 * scale * scale * scale;  // water
-        d.inertia = Vec3(half.y() * half.y() + half.z() * half.z(), half.x() * half.x() + half.z() * half.z(),
-                         half.x() * half.x() + half.y() * half.y())
-                        .asDiagonal() *
-                    (d.mass * scale * scale / 3.0);  // a solid box, as above
+        d.inertia = solidBoxInertia(scale * half, d.mass);
         d.friction = 0.89;
         d.position = scale * Vec3(-1.644, 0.877, half.z());  // across y = 1 (its +y side 1.6 cm over it)
         const BodyId id = world.addBody(d, scale);
