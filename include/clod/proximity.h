@@ -80,8 +80,10 @@ struct MeshDistanceSettings {
   bool forceWindingNumber = false;
   /// Pseudonormals for an open mesh too, where its shared edges are consistently oriented and
   /// its vertices manifold: behind the surface is inside, as for a sheet (a floor quad, a
-  /// terrain) whose winding number never reaches 1/2 off it. Ignored where those do not hold,
-  /// or with forceWindingNumber.
+  /// terrain) whose winding number never reaches 1/2 off it; a point whose closest point is on
+  /// the border and which lies beyond it (off the line along that feature's pseudonormal) is
+  /// outside -- the solid is what lies behind the faces. Ignored where those do not hold, or
+  /// with forceWindingNumber.
   bool sheetPseudonormals = false;
   /// Accuracy of the hierarchical winding number (Barill et al. 2018): a cluster of triangles
   /// is replaced by its second-order far-field expansion when the query point is farther than
