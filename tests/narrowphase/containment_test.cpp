@@ -211,7 +211,9 @@ TEST(Containment, ExactFieldThroughTheTriangleBvhMatchesMeshDistance) {
       if (std::abs(std::abs(expected) - r) <= 1e-9 * body->diagonal()) continue;  // a tie at the radius
       detail::FieldValue within;
       EXPECT_EQ(detail::exactBodyFieldWithin(*body, p, r, scratch, within), std::abs(expected) < r) << p.transpose();
-      if (std::abs(expected) < r) EXPECT_NEAR(within.distance, expected, 1e-12 * body->diagonal());
+      if (std::abs(expected) < r) {
+        EXPECT_NEAR(within.distance, expected, 1e-12 * body->diagonal());
+      }
     }
   }
 }
