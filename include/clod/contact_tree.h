@@ -120,11 +120,12 @@ struct ContactTree {
   /// Shape and surface bitmaps with rank counts, one word per 64 nodes (see the layout above).
   std::vector<ContactTreeNodeWord> nodeWords;
   /// Per node: its error bound divided by cellRadius(depth), as the upper 16 bits of an IEEE
-  /// float (sign 0, 8-bit exponent, 7-bit mantissa), rounded up, so that the decoded bound is
-  /// never below the builder's and at most 2^-7 (0.8 %) above it; farErrorCode(depth) (just
-  /// above 1.0) is the Lipschitz bound of half the cell diagonal plus the value rounding q/2,
-  /// which caps every bound except in cells where the builder found the field discontinuous
-  /// (open meshes, docs/contact-tree.md). Use errorBound().
+  /// float (sign 0, 8-bit exponent, 7-bit mantissa) rounded up to kErrorMantissaBits mantissa
+  /// bits (the low bits zero), so that the decoded bound is never below the builder's and at
+  /// most 2^-3 (12.5 %) above it; or farErrorCode(depth) (just above 1.0, all 7 mantissa bits),
+  /// the Lipschitz bound of half the cell diagonal plus the value rounding q/2, which caps
+  /// every bound except in cells where the builder found the field discontinuous (open meshes,
+  /// docs/contact-tree.md). Use errorBound().
   std::vector<std::uint16_t> errorCode;
   std::vector<std::uint32_t> levelOffsets;  ///< size depthCount() + 1
 
@@ -228,16 +229,27 @@ struct ContactTree {
   /// without measuring, the Lipschitz bound of half the cell diagonal (plus the value rounding
   /// q/2, see valueStep()), which holds everywhere in the cell for any 1-Lipschitz field;
   /// never more than that, except in cells where the field
-  /// is discontinuous (open meshes: the measured bound, uncapped). Rounded up by at most 0.8 %
-  /// (errorCode). This is what a query stopped at this node reports, and what graceful
-  /// degradation uses. `depth` must be the node's depth. O(1).
+  /// is discontinuous (open meshes: the measured bound, uncapped). Rounded up by at most 12.5 %
+  /// (errorCode; the Lipschitz cap by at most 0.8 %). This is what a query stopped at this
+  /// node reports, and what graceful degradation uses. `depth` must be the node's depth. O(1).
   double errorBound(std::uint32_t node, std::uint32_t depth) const {
     return decodeErrorRatio(errorCode[node]) * cellRadius(depth);
   }
-  /// The 16-bit code of a ratio bound / cell radius (upper half of its float), rounded up so
-  /// that decodeErrorRatio(code) >= ratio; ratios beyond the float range map to the largest
-  /// finite code 0x7f7f. Precondition: ratio >= 0, not NaN.
-  static std::uint16_t encodeErrorRatio(double ratio);
+  /// Mantissa bits an error code keeps (of a bfloat16's 7). Every measured bound is rounded
+  /// up to them: the bake file then spends ~4 bits less per node, for bounds at most 12.5 %
+  /// looser (docs/contact-tree.md, "Error bounds").
+  static constexpr int kErrorMantissaBits = 3;
+  /// The largest finite code with kErrorMantissaBits mantissa bits (~3.2e38).
+  static constexpr std::uint16_t kMaxErrorCode = 0x7f70;
+  /// The 16-bit code of a ratio bound / cell radius (upper half of its float), rounded up to
+  /// `mantissaBits` (1..7) mantissa bits so that decodeErrorRatio(code) >= ratio; ratios
+  /// beyond the range map to the largest finite code with those bits. Precondition:
+  /// ratio >= 0, not NaN.
+  static std::uint16_t encodeErrorRatio(double ratio, int mantissaBits = kErrorMantissaBits);
+  /// True when `code` is one encodeErrorRatio makes with kErrorMantissaBits bits.
+  static constexpr bool isCoarseErrorCode(std::uint16_t code) {
+    return code <= kMaxErrorCode && (code & ((1u << (7 - kErrorMantissaBits)) - 1)) == 0;
+  }
   /// Inverse of encodeErrorRatio: a float whose upper 16 bits are `code`.
   static float decodeErrorRatio(std::uint16_t code) {
     return std::bit_cast<float>(static_cast<std::uint32_t>(code) << 16);

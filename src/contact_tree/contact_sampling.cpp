@@ -412,9 +412,14 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
       // sideways along a face that nothing presses on; the cfm model drops such contacts
       // too. Two crossing edges also touch at shallow depths with conflicting fields, so the
       // drop comes after the edge-edge rule has had its say (on our edge).
-      // (O's eps_s is no bound of a flat cell's field: a box's corner 2 mm into a 10 m slab,
-      // whose eps_s is 1 cm, would count as grazing.)
-      const double fieldError = flatO ? double(f.errorBound) : std::max(double(f.errorBound), treeO.errorAbs);
+      // (O's eps_s is no bound of a flat leaf's field, which interpolates its plane exactly: a
+      // box's corner 2 mm into a 10 m slab, whose eps_s is 1 cm, would count as grazing. The
+      // leaf the sample lies in decides, not only O's cell: a bunny's lowest support point,
+      // 0.6 mm into a ground box answered from the two root cells, was dropped as grazing,
+      // and the bunny sank with no contact for four frames.)
+      const ContactHalfSpace* leafPlaneO = treeO.halfSpace(f.node);
+      const bool flatLeafO = flatO || (leafPlaneO && double(leafPlaneO->fitError) <= kFlatFitRel * treeO.cellSize(f.depth));
+      const double fieldError = flatLeafO ? double(f.errorBound) : std::max(double(f.errorBound), treeO.errorAbs);
       const bool shallow = -distance <= fieldError + surface.residual;
       const bool grazing = conflict && shallow;
       if (grazing && surface.flat) continue;

@@ -40,19 +40,22 @@ std::size_t ContactTree::memoryBytes() const {
          supportPoints.size() * sizeof(Vec3);
 }
 
-std::uint16_t ContactTree::encodeErrorRatio(double ratio) {
-  CLOD_ASSERT(ratio >= 0.0);
+std::uint16_t ContactTree::encodeErrorRatio(double ratio, int mantissaBits) {
+  CLOD_ASSERT(ratio >= 0.0 && mantissaBits >= 1 && mantissaBits <= 7);
+  // The low bits of a bfloat16 that a code with `mantissaBits` leaves zero.
+  const int dropped = 16 + 7 - mantissaBits;
+  const std::uint32_t largest = (0x7f7fffffu >> dropped) << (dropped - 16);  // largest finite code
   // Ratios above 1 occur only where the builder found the field discontinuous (open meshes);
   // they must stay representable, or the bound would understate the error there.
-  if (!(ratio < 3.0e38)) return 0x7f7f;  // the largest finite bfloat16
-  // Round up twice: double -> float, then float -> its upper 16 bits (a bfloat16). Both steps
-  // only make the bound larger, so the decoded bound stays a bound.
+  if (!(ratio < 3.0e38)) return static_cast<std::uint16_t>(largest);
+  // Round up twice: double -> float, then float -> its upper bits. Both steps only make the
+  // bound larger, so the decoded bound stays a bound.
   float f = static_cast<float>(ratio);
   if (static_cast<double>(f) < ratio) f = std::nextafter(f, 2.0f);
   const std::uint32_t bits = std::bit_cast<std::uint32_t>(f);
-  std::uint32_t code = bits >> 16;
-  if ((bits & 0xffffu) != 0) ++code;  // positive floats: a larger bit pattern is a larger value
-  return static_cast<std::uint16_t>(std::min<std::uint32_t>(code, 0x7f7f));
+  std::uint32_t kept = bits >> dropped;
+  if ((bits & ((1u << dropped) - 1)) != 0) ++kept;  // positive floats: a larger bit pattern is a larger value
+  return static_cast<std::uint16_t>(std::min<std::uint32_t>(kept << (dropped - 16), largest));
 }
 
 void ContactTree::assignNodeBits(const std::vector<std::uint8_t>& interior, const std::vector<std::uint8_t>& surface) {
@@ -173,7 +176,9 @@ bool ContactTree::provenFar(const std::array<float, 8>& corners, std::uint32_t d
 
 std::uint16_t ContactTree::farErrorCode(std::uint32_t depth) const {
   // |d(x) - sum w_i v_i| <= sum w_i |x - c_i| + max |d(c_i) - v_i| <= D/2 + q/2.
-  return encodeErrorRatio(1.0 + 0.5 * valueStep() / cellRadius(depth));
+  // All 7 mantissa bits: the cap is one coded bit in the bake file, and far cells, the most
+  // numerous, keep their Lipschitz bound within 0.8 %.
+  return encodeErrorRatio(1.0 + 0.5 * valueStep() / cellRadius(depth), 7);
 }
 
 ContactCell ContactTree::rootCell() const {

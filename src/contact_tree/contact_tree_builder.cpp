@@ -313,7 +313,7 @@ void Builder::measureCell(const PendingCell& cell, std::uint32_t depth, double* 
       const Vec3 offset = 0.5 * h * Vec3((l % 3) - 1.0, ((l / 3) % 3) - 1.0, (l / 9) - 1.0);
       fit = std::max(fit, std::abs(nr.dot(offset) - double(r.halfSpace.offset) - exact[l]));
     }
-    r.halfSpace.fitError = detail::fitErrorFromCode(ContactTree::encodeErrorRatio(fit / h), h);
+    r.halfSpace.fitError = detail::fitErrorFromCode(ContactTree::encodeErrorRatio(fit / h, detail::kFitMantissaBits), h);
   }
 }
 

@@ -25,6 +25,13 @@ using detail::kLatticeSlot;
 // 2^48 cap, so sums of eight of them cannot overflow.
 constexpr double kMaxUnits = 70368744177664.0;  // 2^46
 constexpr int kDepthContexts = 16;
+// An error code is its high byte (7 bits: the exponent's upper 7) and then the exponent's last
+// bit and the kErrorMantissaBits mantissa bits; the bits below are zero (isCoarseErrorCode).
+constexpr int kErrorLowBits = 1 + ContactTree::kErrorMantissaBits;
+constexpr int kErrorLowShift = 8 - kErrorLowBits;
+constexpr int kErrorLowCodes = 1 << kErrorLowBits;
+constexpr int kFitLowBits = 1 + detail::kFitMantissaBits;
+constexpr int kFitLowShift = 8 - kFitLowBits;
 
 // What the residuals of a split node coded so far say about the next one: their mean magnitude
 // (the field's curvature at this cell's scale: an edge or a bend gives large residuals all
@@ -53,13 +60,13 @@ struct Models {
   BitModel surface[2][3][2];  // [split][|centre estimate| / radius bucket][corner signs differ]
   BitModel errorFar[2][kDepthContexts];  // [split][depth]: the code is the Lipschitz cap farErrorCode
   BitModel errorHigh[2][2][kDepthContexts][128];  // [split][surface][depth]
-  BitModel errorLow[2][8][256];  // [split][low 3 bits of the high byte]
+  BitModel errorLow[2][8][kErrorLowCodes];  // [split][low 3 bits of the high byte]
   // [odd coordinates - 1: edge, face, centre][depth][LatticeActivity::context()]
   IntModel lattice[3][kDepthContexts][LatticeActivity::kContexts];
   IntModel normal[2][2];                // [split][component]
   IntModel offset[2];
   BitModel fitHigh[2][kDepthContexts][128];
-  BitModel fitLow[2][8][256];
+  BitModel fitLow[2][8][1 << kFitLowBits];
   BitModel normalFromAncestor[2][2];  // [split][the cell has an ancestor with a half-space]
 };
 
@@ -191,9 +198,9 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
       const bool farCode = code == tree.farErrorCode(d);
       enc.encodeBit(models->errorFar[split][dc], farCode ? 1u : 0u);
       if (!farCode) {
-        if (code > 0x7f7f) bad("error code is not a finite bound");
+        if (!ContactTree::isCoarseErrorCode(code)) bad("error code is not a finite bound the codec stores");
         enc.encodeTree(models->errorHigh[split][hs ? 1 : 0][dc], 7, code >> 8);
-        enc.encodeTree(models->errorLow[split][(code >> 8) & 7u], 8, code & 0xffu);
+        enc.encodeTree(models->errorLow[split][(code >> 8) & 7u], kErrorLowBits, (code & 0xffu) >> kErrorLowShift);
       }
 
       if (hs) {
@@ -235,7 +242,7 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
         if (!detail::findFitCode(hs->fitError, tree.cellSize(d), fitCode)) bad("half-space fit error is not one the codec stores");
         enc.encodeInt(models->offset[split], offsetUnits);
         enc.encodeTree(models->fitHigh[split][dc], 7, fitCode >> 8u);
-        enc.encodeTree(models->fitLow[split][(fitCode >> 8) & 7u], 8, fitCode & 0xffu);
+        enc.encodeTree(models->fitLow[split][(fitCode >> 8) & 7u], kFitLowBits, (fitCode & 0xffu) >> kFitLowShift);
       }
     }
     level.swap(next);
@@ -313,8 +320,8 @@ ContactTree decodeContactTree(ByteReader& in) {
       std::uint32_t code = tree.farErrorCode(d);
       if (dec.decodeBit(models->errorFar[split][dc]) == 0) {
         const std::uint32_t high = dec.decodeTree(models->errorHigh[split][surface ? 1 : 0][dc], 7);
-        code = (high << 8) | dec.decodeTree(models->errorLow[split][high & 7u], 8);
-        if (code > 0x7f7f) fail("errorCode[" + std::to_string(node) + "] is not a finite bound >= 0");
+        code = (high << 8) | (dec.decodeTree(models->errorLow[split][high & 7u], kErrorLowBits) << kErrorLowShift);
+        if (code > ContactTree::kMaxErrorCode) fail("errorCode[" + std::to_string(node) + "] is not a finite bound >= 0");
       }
       tree.errorCode.push_back(static_cast<std::uint16_t>(code));
       interiorFlags.push_back(split ? 1 : 0);
@@ -326,7 +333,7 @@ ContactTree decodeContactTree(ByteReader& in) {
         const std::array<std::int32_t, 2> prior = fromAncestor ? cell.ancestorNormal : guess.normal;
         const std::int64_t a = prior[0] + dec.decodeInt(models->normal[split][0]);
         const std::int64_t b = prior[1] + dec.decodeInt(models->normal[split][1]);
-        if (std::abs(a) > 32767 || std::abs(b) > 32767) fail("half-space normal code of node " + std::to_string(node) + " is out of range");
+        if (std::abs(a) > detail::kOctCodeMax || std::abs(b) > detail::kOctCodeMax) fail("half-space normal code of node " + std::to_string(node) + " is out of range");
         cell.ancestorNormal = {static_cast<std::int32_t>(a), static_cast<std::int32_t>(b)};
         cell.hasAncestorNormal = true;
         hs.normal = detail::decodeOctNormal(cell.ancestorNormal[0], cell.ancestorNormal[1]);
@@ -348,8 +355,8 @@ ContactTree decodeContactTree(ByteReader& in) {
       if (surface) {
         const std::int64_t offsetUnits = dec.decodeInt(models->offset[split]);
         const std::uint32_t fitHigh = dec.decodeTree(models->fitHigh[split][dc], 7);
-        const std::uint32_t fitCode = (fitHigh << 8) | dec.decodeTree(models->fitLow[split][fitHigh & 7u], 8);
-        if (!(std::abs(double(offsetUnits)) < kMaxUnits) || fitCode > 0x7f7f) fail("half-space of node " + std::to_string(node) + " is out of range");
+        const std::uint32_t fitCode = (fitHigh << 8) | (dec.decodeTree(models->fitLow[split][fitHigh & 7u], kFitLowBits) << kFitLowShift);
+        if (!(std::abs(double(offsetUnits)) < kMaxUnits) || fitCode > 0x7f7fu) fail("half-space of node " + std::to_string(node) + " is out of range");
         hs.offset = detail::storedValue(detail::offsetPrediction(corners, split, lattice[13]), offsetUnits, hsStep);
         hs.fitError = detail::fitErrorFromCode(static_cast<std::uint16_t>(fitCode), tree.cellSize(d));
         if (!std::isfinite(hs.offset) || !std::isfinite(hs.fitError)) fail("half-space of node " + std::to_string(node) + " is not finite");

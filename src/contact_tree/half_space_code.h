@@ -4,17 +4,20 @@
 // integers). docs/contact-tree.md, "Compact storage", has the precision argument.
 //
 //  * normal: octahedral map of the unit sphere onto [-1, 1]^2 (Meyer et al. 2010, "On
-//    floating-point normal vectors"), each coordinate rounded to a multiple of 1/32767; the
-//    decoded normal is normalised in double and stored as float. Angular error < 5e-5 rad.
+//    floating-point normal vectors"), each coordinate rounded to a multiple of 1/kOctScale;
+//    the decoded normal is normalised in double and stored as float. Angular error < 2e-4 rad
+//    (0.012 deg); axis directions are exact. The builder fits its plane to the rounded normal,
+//    so the rounding shows in fitError, not as a hidden error.
 //  * offset: the centre estimate (-centre value of a split cell, else -trilinear centre value)
-//    plus an integer multiple of latticeStep / 1024 (lattice.h), rounded to nearest: the plane
-//    moves by at most 2^-14 eps_s (samples are placed on it, so it must stay that close: a
-//    box face cell next to an edge, where the prediction is not exact, keeps its face plane
-//    within 1e-6; a step of latticeStep / 16 moved it by 1.3e-5, ctest ContactTreeBox).
-//  * fitError: fitError / h as a 16-bit code rounded up (ContactTree::encodeErrorRatio), so it
-//    stays an upper bound and keeps its relative precision (2^-7) however small it is. (A
-//    3-bit mantissa, as the error bounds have, flips cells across the contact sampler's
-//    flat / edge threshold 0.1 h: a resting spot then tipped over in the world.)
+//    plus an integer multiple of latticeStep / kOffsetStepDivisor (lattice.h), rounded to
+//    nearest: the plane moves by at most 2^-14 eps_s (samples are placed on it, so it must stay
+//    that close: a box face cell whose prediction comes from rounded corner values keeps its
+//    face plane within 1e-6; a step of latticeStep / 32 moved it by 8e-6, ctest ContactTreeBox).
+//  * fitError: fitError / h as an error code rounded up (ContactTree::encodeErrorRatio with
+//    all 7 mantissa bits), so it stays an upper bound and keeps its relative precision (2^-7)
+//    however small it is. (With the error bounds' 3 bits, cells near the contact sampler's
+//    flat / edge threshold 0.1 h flip, and a sphere's manifold turned 6.2 degrees off the
+//    centre line, ctest NarrowPhaseSpheres.)
 
 #include <array>
 #include <cmath>
@@ -25,7 +28,10 @@
 
 namespace clod::detail {
 
-inline constexpr double kOctScale = 32767.0;
+inline constexpr std::int32_t kOctCodeMax = 8191;
+inline constexpr double kOctScale = kOctCodeMax;
+/// Mantissa bits of a fit error's code (ContactTree::encodeErrorRatio).
+inline constexpr int kFitMantissaBits = 7;
 /// Offsets are stored in steps of latticeStep / kOffsetStepDivisor.
 inline constexpr double kOffsetStepDivisor = 1024.0;
 
@@ -42,7 +48,7 @@ inline std::array<std::int32_t, 2> encodeOctNormal(double x, double y, double z)
   return {static_cast<std::int32_t>(std::lround(u * kOctScale)), static_cast<std::int32_t>(std::lround(v * kOctScale))};
 }
 
-/// The unit normal (as floats) of an octahedral code; codes outside [-32767, 32767] are the
+/// The unit normal (as floats) of an octahedral code; codes outside [-kOctCodeMax, kOctCodeMax] are the
 /// caller's error (the decoder checks them).
 inline std::array<float, 3> decodeOctNormal(std::int32_t a, std::int32_t b) {
   double u = a / kOctScale, v = b / kOctScale;
@@ -67,7 +73,7 @@ inline bool findOctCode(const std::array<float, 3>& n, std::array<std::int32_t, 
     for (int da = -1; da <= 1; ++da)
       for (int db = -1; db <= 1; ++db) {
         const std::int32_t a = ((mirror & 1) ? -guess[0] : guess[0]) + da, b = ((mirror & 2) ? -guess[1] : guess[1]) + db;
-        if (std::abs(a) > 32767 || std::abs(b) > 32767) continue;
+        if (std::abs(a) > kOctCodeMax || std::abs(b) > kOctCodeMax) continue;
         // Bit for bit: a zero component may decode as -0.0 from one code and +0.0 from another.
         const std::array<float, 3> m = decodeOctNormal(a, b);
         if (std::memcmp(m.data(), n.data(), sizeof(m)) == 0) {
@@ -88,8 +94,10 @@ inline float fitErrorFromCode(std::uint16_t code, double h) {
 /// The code of a stored fit error, or false if no code gives exactly this value.
 inline bool findFitCode(float fitError, double h, std::uint16_t& code) {
   if (!(fitError >= 0.0f) || !std::isfinite(fitError)) return false;
-  const std::uint16_t guess = ContactTree::encodeErrorRatio(double(fitError) / h);
-  for (int c = int(guess) - 1; c <= int(guess) + 1; ++c) {
+  // fitErrorFromCode rounds up, so the code is the re-encoded guess or a neighbour of it.
+  const int codeStep = 1 << (7 - kFitMantissaBits);
+  const std::uint16_t guess = ContactTree::encodeErrorRatio(double(fitError) / h, kFitMantissaBits);
+  for (int c = int(guess) - codeStep; c <= int(guess) + codeStep; c += codeStep) {
     if (c < 0 || c > 0x7f7f) continue;
     if (fitErrorFromCode(static_cast<std::uint16_t>(c), h) == fitError) {
       code = static_cast<std::uint16_t>(c);

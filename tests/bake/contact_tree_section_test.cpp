@@ -224,10 +224,10 @@ TEST_F(BakeContactTree, TrailingOrMissingPayloadBytesAndNewerVersionsAreRejected
   innerNewer[0] = std::byte{kContactTreeCodecVersion + 1};  // the codec's own u32 version, little-endian
   EXPECT_EQ(thrownCode([&] { decodeBake(fileWithTreePayload(baked_->contents, innerNewer)); }), ErrorCode::kBakeVersion);
   // Files from before the compact encoding (codec version 2: float arrays; version 1: 32-bit
-  // child indices) and from its first coding (version 3) must not be
-  // misread as the current layout: they are refused by version, with a message saying so and
-  // asking for a re-bake.
-  for (std::uint8_t old : {std::uint8_t{1}, std::uint8_t{2}, std::uint8_t{3}}) {
+  // child indices) and from its earlier codings (versions 3 and 4: error codes with 7 mantissa
+  // bits, finer half-spaces) must not be misread as the current layout: they are refused by
+  // version, with a message saying so and asking for a re-bake.
+  for (std::uint8_t old : {std::uint8_t{1}, std::uint8_t{2}, std::uint8_t{3}, std::uint8_t{4}}) {
     std::vector<std::byte> innerOld = payload;
     innerOld[0] = std::byte{old};
     const std::vector<std::byte> oldFile = fileWithTreePayload(baked_->contents, innerOld);

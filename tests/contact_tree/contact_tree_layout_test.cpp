@@ -34,24 +34,33 @@ TEST(ContactTreeRank, PopcountCountsEveryBit) {
   for (std::uint64_t w : words) ASSERT_EQ(detail::popcount64(w), oneByOne(w)) << std::hex << w;
 }
 
-TEST(ContactTreeErrorCode, DecodedBoundIsNeverBelowTheRatioAndAtMostOnePartIn128Above) {
+TEST(ContactTreeErrorCode, DecodedBoundIsNeverBelowTheRatioAndAtMostOneMantissaStepAbove) {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> exponent(-40.0, 10.0);
-  for (int i = 0; i < 100000; ++i) {
-    const double ratio = std::exp2(exponent(rng));
-    const double decoded = ContactTree::decodeErrorRatio(ContactTree::encodeErrorRatio(ratio));
-    ASSERT_GE(decoded, ratio) << ratio;
-    // A bfloat16 has 7 explicit mantissa bits: the next code up is at most 2^-7 larger.
-    ASSERT_LE(decoded, ratio * (1.0 + std::ldexp(1.0, -7))) << ratio;
+  for (int bits : {ContactTree::kErrorMantissaBits, 7}) {
+    for (int i = 0; i < 100000; ++i) {
+      const double ratio = std::exp2(exponent(rng));
+      const std::uint16_t code = ContactTree::encodeErrorRatio(ratio, bits);
+      const double decoded = ContactTree::decodeErrorRatio(code);
+      ASSERT_GE(decoded, ratio) << ratio;
+      // With m explicit mantissa bits the next code up is at most 2^-m larger.
+      ASSERT_LE(decoded, ratio * (1.0 + std::ldexp(1.0, -bits))) << ratio << " with " << bits << " bits";
+      if (bits == ContactTree::kErrorMantissaBits) {
+        ASSERT_TRUE(ContactTree::isCoarseErrorCode(code)) << std::hex << code;
+      }
+    }
   }
 }
 
 TEST(ContactTreeErrorCode, ZeroOneAndHugeRatiosAreExactOrFinite) {
-  EXPECT_EQ(ContactTree::decodeErrorRatio(ContactTree::encodeErrorRatio(0.0)), 0.0f);
-  EXPECT_EQ(ContactTree::decodeErrorRatio(ContactTree::encodeErrorRatio(1.0)), 1.0f);
-  EXPECT_EQ(ContactTree::decodeErrorRatio(ContactTree::encodeErrorRatio(0.5)), 0.5f);
-  const float huge = ContactTree::decodeErrorRatio(ContactTree::encodeErrorRatio(1e300));
-  EXPECT_TRUE(std::isfinite(huge) && huge > 1e38f);
+  for (int bits : {ContactTree::kErrorMantissaBits, 7}) {
+    EXPECT_EQ(ContactTree::decodeErrorRatio(ContactTree::encodeErrorRatio(0.0, bits)), 0.0f);
+    EXPECT_EQ(ContactTree::decodeErrorRatio(ContactTree::encodeErrorRatio(1.0, bits)), 1.0f);
+    EXPECT_EQ(ContactTree::decodeErrorRatio(ContactTree::encodeErrorRatio(0.5, bits)), 0.5f);
+    const float huge = ContactTree::decodeErrorRatio(ContactTree::encodeErrorRatio(1e300, bits));
+    EXPECT_TRUE(std::isfinite(huge) && huge > 1e38f) << bits;
+  }
+  EXPECT_EQ(ContactTree::encodeErrorRatio(1e300), ContactTree::kMaxErrorCode);
 }
 
 // A box tree with a few thousand nodes spread over several 64-node words.
