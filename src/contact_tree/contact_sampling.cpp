@@ -17,6 +17,9 @@ constexpr double kPi = 3.14159265358979323846;
 // (exactly 0 on a face, ~0.3 of the size for a cell holding a right-angled edge).
 constexpr double kFlatFitRel = 0.1;
 
+// True when `hs` (may be null: no surface in the cell) fits a cell of side `size` flat.
+bool fitsFlat(const ContactHalfSpace* hs, double size) { return hs && double(hs->fitError) <= kFlatFitRel * size; }
+
 void checkSettings(const ContactSamplingSettings& s) {
   auto bad = [](const std::string& what) { throw Error(ErrorCode::kInvalidArgument, "contact sampling settings: " + what); };
   if (!(std::isfinite(s.marginAbs) && s.marginAbs >= 0.0)) bad("marginAbs must be finite and >= 0");
@@ -150,7 +153,7 @@ bool describeSurface(const ContactTree& tree, const ContactFieldSample& f, Surfa
   at.normal = f.gradient / length;
   const ContactHalfSpace* hs = tree.halfSpace(f.node);
   at.size = tree.cellSize(f.depth);
-  at.flat = hs && double(hs->fitError) <= kFlatFitRel * at.size;
+  at.flat = fitsFlat(hs, at.size);
   at.offset = f.distance;
   at.residual = std::abs(f.distance);
   at.error = f.errorBound;
@@ -344,7 +347,7 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
   }
   const double conflictCos = std::cos(settings.normalConflictDeg * kPi / 180.0);
   const std::size_t firstOut = out.size();
-  const bool flatS = double(hs->fitError) <= kFlatFitRel * h;
+  const bool flatS = fitsFlat(hs, h);
   // The plane of an inner cell that holds edges, corners or several faces is no surface (a
   // slab's 5 m cell fits a plane through the slab's middle, standing on end): its lattice points
   // would be phantom surface points, and a box sliding over the slab at 256 tests per frame
@@ -418,7 +421,8 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
       // 0.6 mm into a ground box answered from the two root cells, was dropped as grazing,
       // and the bunny sank with no contact for four frames.)
       const ContactHalfSpace* leafPlaneO = treeO.halfSpace(f.node);
-      const bool flatLeafO = flatO || (leafPlaneO && double(leafPlaneO->fitError) <= kFlatFitRel * treeO.cellSize(f.depth));
+      const bool leafFlatO = fitsFlat(leafPlaneO, treeO.cellSize(f.depth));
+      const bool flatLeafO = flatO || leafFlatO;
       const double fieldError = flatLeafO ? double(f.errorBound) : std::max(double(f.errorBound), treeO.errorAbs);
       const bool shallow = -distance <= fieldError + surface.residual;
       const bool grazing = conflict && shallow;
@@ -442,8 +446,7 @@ void sampleUnchecked(const ContactTree& treeS, const ContactCell& cellS, const P
       } else if (conflict && surface.flat) {
         // The other body shows an edge or corner here while our cell is a flat face: an edge
         // or vertex on a face pushes along the face normal, not along the rounded field.
-        const ContactHalfSpace* ho = treeO.halfSpace(f.node);
-        if (ho && double(ho->fitError) > kFlatFitRel * treeO.cellSize(f.depth)) normal = -normalWorldS;
+        if (leafPlaneO && !leafFlatO) normal = -normalWorldS;
       }
       out.push_back({pWorld, normal, -distance, f.errorBound + surface.residual, 0});
       break;  // the off-surface sample below a contact would only repeat it, deeper
