@@ -140,13 +140,17 @@ struct ManifoldSettings {
 
 /// Reduces `contacts` to a manifold of at most settings.maxContacts well-spread contacts, in
 /// place: on return the kept contacts are contacts[0 .. n), where n is the return value.
-/// Rule: keep the deepest contact first (among contacts equally deep within 1e-6 of its depth,
-/// the one farthest from the contacts' centroid in the contact plane: an end of an edge lying
-/// flat, not whichever came first), then the one farthest from it, then the two farthest
-/// from the line through those (one on each side), all distances measured in the plane
-/// perpendicular to the deepest contact's normal -- for a face-on-face overlap, four corners;
-/// then repeatedly add the contact whose smallest distance to the kept ones is largest
-/// (farthest-point sampling in the contact plane); stop at maxContacts. A contact within
+/// Rule: keep the deepest contact first (among contacts equally deep within 1e-6 of its depth or
+/// 1e-4 of the contacts' extent, the one farthest from the contacts' centroid in the contact
+/// plane: an end of an edge lying flat, not whichever came first), then the one farthest from
+/// it, then the two farthest from the line through those (one on each side), all distances
+/// measured in the plane perpendicular to the deepest contact's normal -- for a face-on-face
+/// overlap, four corners; then repeatedly add the contact that adds most support: once the kept
+/// contacts facing the deepest one's way (within 1 deg) span a polygon, the one farthest outside
+/// it, or among those inside it but deeper than the plane of the kept depths (by 1e-4 of its
+/// extent), the one farthest from the kept ones; contacts inside it and no deeper are not kept (a
+/// face on a face keeps its overlap's corners only). Where no polygon has a say, farthest-point
+/// sampling in the contact plane. Stop at maxContacts. A contact within
 /// mergeDistanceAbs of a kept one is never kept. Other ties are broken by input order, so
 /// the result depends only on the input sequence. Then, if poolNormalsCos <= 1, the kept
 /// contacts' normals are pooled (ManifoldSettings::poolNormalsCos). `scratch` is reused (no allocation once it

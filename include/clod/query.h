@@ -84,6 +84,8 @@ struct QuerySettings {
   double mergeDistanceRel = 1e-3;
   /// Contact sampling of the contact-tree model. Its maxDepth is ignored (the traversal decides
   /// how deep to go) and its own per-patch thinning is not applied: the manifold reduction is.
+  /// Its marginAbs applies to finished answers only (an interrupted answer's depths are known to
+  /// within its coarse cells' bounds); the world sets it to 1e-4 of the smaller diagonal.
   ContactSamplingSettings contactSampling;
   /// Deepest hierarchy level the traversal descends to (0 = the roots): nodes at this level count
   /// as leaves, so the answer is the one "resolved at level maxLevel" (the papers' experiments).

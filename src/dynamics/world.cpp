@@ -18,6 +18,7 @@
 #include "clod/query.h"
 #include "dynamics/ball_contacts.h"
 #include "narrowphase/separation.h"
+#include "narrowphase/support_polygon.h"
 
 namespace clod {
 namespace {
@@ -33,6 +34,16 @@ constexpr double kWarmStartNormalCos = 0.95;
 // less than this fraction of the smaller body's diagonal (tangentially) and have not opened by
 // more than it (Bullet's contact breaking threshold plays the same role: 2 cm for unit bodies).
 constexpr double kAnchorDriftRel = 0.01;
+// The contact tree's samples within this fraction of the smaller diagonal of touching are
+// contacts (speculative ones where they are apart): a face resting on a face touches at depth ~0,
+// where the fields' noise (~1e-6 of the diagonal on flat cells, within their error bounds) puts
+// some samples a hair inside and the rest a hair outside. With no margin the answer held whichever
+// corner the noise made deepest -- one contact of a box at rest, changing from substep to substep
+// -- and a box spinning on the floor drifted 12 cm on the interior contacts the persistent manifold
+// carried in between (the exact model: 0). Far below the slop (2e-3), so a speculative contact's
+// allowed approach (its gap per substep) never matters to a body in flight. Finished answers only
+// (QuerySettings::contactSampling; docs/narrow-phase.md, "Margin").
+constexpr double kSampleMarginRel = 1e-4;
 // A pair that leaves the broad phase keeps its coherence cache while the two bodies' boxes are
 // less than this fraction of the smaller diagonal apart (hysteresis, as a pair cache's): a body
 // that hops by a hair and lands again resumes the front it had refined instead of starting from
@@ -783,6 +794,7 @@ struct World::Impl {
   void carryValidContacts(PairState& p, const Body& a, const Body& b, double matchDistance, double drift);
   void reduceCarried(std::vector<SolverContact>& contacts, std::size_t keep);
   std::vector<double> spread;  // reduceCarried's farthest-point distances
+  std::vector<double> supportRoom;  // carryValidContacts' support polygon of the fresh contacts
   double kineticEnergyOfDynamicBodies() const;
   // Second-order positions along the directions no contact constrains (integrate): each body's
   // velocity at the start of the substep, and an orthonormal basis of its pressing or touching
@@ -1255,6 +1267,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       }
     }
     --left;
+    qs.contactSampling.marginAbs = kSampleMarginRel * std::min(a.desc.shape->diagonal(), bb.desc.shape->diagonal());
     queryContacts(*a.desc.shape, a.pose(), *bb.desc.shape, bb.pose(), qs, scratch, result, &p->cache);
     if (pastTimeFallback) {
       // Reported as a fallback (QueryResult's convention): every frontier pair was answered by cfm.
@@ -1516,6 +1529,14 @@ void World::Impl::carryValidContacts(PairState& p, const Body& a, const Body& b,
   // floor. What is still pressed of the last manifold stays instead.
   const bool provedNothing = p.interrupted && !(p.apartBy > 0.0);
   if (fresh == 0 && !provedNothing) return;
+  // A previous contact inside the fresh answer's support polygon, no deeper than it says, adds
+  // nothing to the support (narrowphase/support_polygon.h): carried, it only takes a share of the
+  // load where the answer has none (a box spinning on the floor kept its slow interior points while
+  // the corners moved on).
+  supportRoom.resize(3 * fresh);
+  detail::SupportPolygon polygon(fresh > 0 ? p.contacts[0].c.normal : Vec3::UnitZ(), supportRoom);
+  for (std::size_t i = 0; i < fresh; ++i) polygon.add(p.contacts[i].c);
+  polygon.close();
   for (const SolverContact& old : p.previous) {
     if (old.matched) continue;
     const Vec3 pA = pointOnA(a, old.anchorA, old.c.normal), pB = pointOnB(b, old.anchorB, old.c.normal);
@@ -1531,9 +1552,12 @@ void World::Impl::carryValidContacts(PairState& p, const Body& a, const Body& b,
     // With no fresh contact to agree with, only a still-pressed one is kept: one that has opened
     // no longer supports anything, and its warm-started impulse kept a rocking bunny rocking.
     if (fresh > 0 ? near || !agrees : open > 0.0) continue;
+    Contact carried = old.c;
+    carried.point = mid;
+    carried.depth = -open;
+    if (polygon.addsNothing(carried)) continue;
     p.contacts.push_back(old);
-    p.contacts.back().c.point = mid;
-    p.contacts.back().c.depth = -open;
+    p.contacts.back().c = carried;
   }
   if (p.contacts.size() > settings.maxContacts) reduceCarried(p.contacts, settings.maxContacts);
 }

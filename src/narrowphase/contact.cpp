@@ -4,10 +4,12 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <string>
 #include <utility>
 
 #include "clod/error.h"
+#include "narrowphase/support_polygon.h"
 
 namespace clod {
 namespace {
@@ -16,6 +18,11 @@ namespace {
 // rounding (a vertex's depth from two models' arithmetic differed by ~1e-12 relative), far below
 // any depth difference the solver could act on.
 constexpr double kDepthTieRel = 1e-6;
+// ... and so do depths within this fraction of the contacts' extent: the contact tree's samples of
+// a face lying flat differ by field noise (~3e-6 of the face's size at 3e-8 m deep, far more than
+// 1e-6 of the depth), and the deepest of them was an interior sample picked by that noise. The
+// same tolerance as the support polygon's depth plane (narrowphase/support_polygon.cpp).
+constexpr double kDepthTieExtentRel = 1e-4;
 
 constexpr std::array<ContactModel, 5> kModels = {ContactModel::kDos, ContactModel::kAverage, ContactModel::kCfm,
                                                  ContactModel::kContactTree, ContactModel::kExact};
@@ -51,11 +58,12 @@ std::size_t reduceManifold(std::span<Contact> contacts, const ManifoldSettings& 
   const std::size_t n = contacts.size();
   if (n == 0) return 0;
 
-  // Deepest first. Among contacts as deep within kDepthTieRel (a face or an edge lying flat on
-  // another: many equal depths, which differ only by rounding), the one farthest from the
-  // contacts' centroid: an end of the edge, a corner of the face. Before, input order broke
-  // the tie, so two models that found the same vertices of a fandisk's edge lying flat on a box
-  // kept different subsets -- one without the edge's end -- and the drop turned differently.
+  // Deepest first. Among contacts as deep within kDepthTieRel or kDepthTieExtentRel (a face or an
+  // edge lying flat on another: many equal depths, which differ only by rounding or field noise),
+  // the one farthest from the contacts' centroid: an end of the edge, a corner of the face.
+  // Before, input order broke the tie, so two models that found the same vertices of a fandisk's
+  // edge lying flat on a box kept different subsets -- one without the edge's end -- and the drop
+  // turned differently.
   std::size_t strict = 0;
   for (std::size_t i = 1; i < n; ++i) {
     if (contacts[i].depth > contacts[strict].depth) strict = i;
@@ -74,10 +82,13 @@ std::size_t reduceManifold(std::span<Contact> contacts, const ManifoldSettings& 
     const bool facing = contacts[i].normal.dot(normal) >= kSamePlaneCos && contacts[k].normal.dot(normal) >= kSamePlaneCos;
     return facing ? planar(d) : d.squaredNorm();
   };
-  const double tieDepth = contacts[strict].depth - kDepthTieRel * std::abs(contacts[strict].depth);
   Vec3 centroid = Vec3::Zero();
   for (std::size_t i = 0; i < n; ++i) centroid += contacts[i].point;
   centroid /= static_cast<double>(n);
+  double reach = 0.0;  // the contacts' largest squared distance from their centroid, in the plane
+  for (std::size_t i = 0; i < n; ++i) reach = std::max(reach, planar(contacts[i].point - centroid));
+  const double tieDepth = contacts[strict].depth - std::max(kDepthTieRel * std::abs(contacts[strict].depth),
+                                                            kDepthTieExtentRel * 2.0 * std::sqrt(reach));
   std::size_t deepest = strict;
   double deepestSpread = planar(contacts[strict].point - centroid);
   for (std::size_t i = 0; i < n; ++i) {
@@ -89,7 +100,9 @@ std::size_t reduceManifold(std::span<Contact> contacts, const ManifoldSettings& 
 
   // scratch[i]: squared planar distance of contact i to the kept set (the scores);
   // scratch[n + i]: its squared `apart` distance (whether it merges into a kept one).
-  scratch.resize(2 * n);
+  // scratch[2n ..): the support polygon's room (3 per kept contact).
+  const std::size_t polygonRoom = 3 * std::min<std::size_t>(settings.maxContacts, n);
+  scratch.resize(2 * n + polygonRoom);
   double* whole = scratch.data() + n;
   for (std::size_t i = 1; i < n; ++i) scratch[i] = planar(contacts[i].point - contacts[0].point), whole[i] = apart(i, 0);
   const double mergeSquared = settings.mergeDistanceAbs * settings.mergeDistanceAbs;
@@ -140,8 +153,21 @@ std::size_t reduceManifold(std::span<Contact> contacts, const ManifoldSettings& 
       if (chosen < n) keep(chosen);
     }
   }
+  // Then picks that add support area or depth (narrowphase/support_polygon.h): the contact farthest
+  // outside the support polygon of the kept ones, or farthest from them among those that lie deeper
+  // than the polygon's depth plane, or -- where the polygon has no say (a wall's contacts beside a
+  // floor's, a curved patch) -- farthest from them. A contact inside the polygon and no deeper
+  // adds nothing the solver can use, only another point to share the load: a face lying on a face
+  // is held at the corners of the overlap, not at interior samples. The contact tree's samples of
+  // a flat face differ in depth by field noise far below their bounds, and farthest-point picks
+  // among them followed that noise, so the load -- and the friction of a box spinning on the
+  // floor -- was uneven and the box drifted 12 cm where the exact model's stood still.
   while (kept < settings.maxContacts && kept < n) {
-    const std::size_t chosen = best(farthest);
+    detail::SupportPolygon polygon(normal, {scratch.data() + 2 * n, polygonRoom});
+    for (std::size_t k = 0; k < kept; ++k) polygon.add(contacts[k]);
+    polygon.close();
+    const std::size_t chosen =
+        best([&](std::size_t i, double distance) { return polygon.pickScore(contacts[i], distance); });
     if (chosen == n) break;
     keep(chosen);
   }

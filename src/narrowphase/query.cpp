@@ -2857,6 +2857,10 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
                         warm ? &c->cellOverlapping : nullptr, warm ? &c->cellSeparated : nullptr, 0, smallestGap);
     fillFrontier(s.cellFront, sa, sb, result);
     ContactSamplingSettings sampling = settings.contactSampling;
+    // Samples within the margin of touching are contacts only in a finished answer: an
+    // interrupted one's depths are its coarse cells' support points, known only to within their
+    // bounds (centimetres on a 1 m box), so "within the margin" says nothing there.
+    if (!finished) sampling.marginAbs = 0.0;
     sampling.maxDepth = kContactTreeLeafDepth;
     sampling.supportPoints = !finished;
     s.sampled.clear();
@@ -2875,7 +2879,7 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
       const std::uint32_t level = std::max(p.a.depth, p.b.depth);
       for (std::size_t i = first; i < s.sampled.size(); ++i) {
         const ContactPoint& cp = s.sampled[i];
-        if (cp.depth < -settings.contactSampling.marginAbs) continue;
+        if (cp.depth < -sampling.marginAbs) continue;
         Contact ct;
         ct.point = cp.point;
         ct.normal = cp.normal;

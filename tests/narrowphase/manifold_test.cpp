@@ -107,6 +107,76 @@ TEST(ReduceManifold, KeepsAFaceCornersThatLineUpAlongAPerpendicularDeeperNormal)
   EXPECT_NEAR(std::abs(contacts[1].point.x() - contacts[2].point.x()), 2.0, 1e-15);
 }
 
+// A face lying flat on a face, sampled as the contact tree samples it: a 0.83 x 0.27 lattice whose
+// depths differ by field noise (+-2e-8 m around 3e-8), far below anything the solver can act on.
+// Only the overlap's four corners are kept: the interior samples add no support area and no
+// depth. Before, farthest-point picks filled the manifold's 8 places with interior samples chosen
+// by that noise, which loaded the face unevenly (a box spinning on a floor drifted 12 cm).
+TEST(ReduceManifold, KeepsOnlyTheCornersOfAFlatFaceWhoseDepthsDifferByNoise) {
+  const double hx = 0.415, hy = 0.135;
+  std::vector<Contact> contacts;
+  for (int i = 0; i <= 16; ++i)
+    for (int j = 0; j <= 6; ++j) {
+      const double noise = 2e-8 * std::sin(12.9898 * i + 78.233 * j);  // deterministic, |noise| <= 2e-8
+      contacts.push_back(at(-hx + 2 * hx * i / 16, -hy + 2 * hy * j / 6, 3e-8 + noise));
+    }
+  std::vector<double> scratch;
+  const std::size_t n = reduceManifold(contacts, {8, 1e-3}, scratch);
+  ASSERT_EQ(n, 4u);
+  for (std::size_t i = 0; i < n; ++i) {
+    EXPECT_NEAR(std::abs(contacts[i].point.x()), hx, 1e-12);
+    EXPECT_NEAR(std::abs(contacts[i].point.y()), hy, 1e-12);
+  }
+  // One corner each.
+  std::vector<int> quadrants;
+  for (std::size_t i = 0; i < n; ++i) quadrants.push_back((contacts[i].point.x() > 0) * 2 + (contacts[i].point.y() > 0));
+  std::sort(quadrants.begin(), quadrants.end());
+  EXPECT_EQ(quadrants, (std::vector<int>{0, 1, 2, 3}));
+}
+
+// The same face over two bumps: the deepest contact (2 mm above the face's depth) and a second
+// bump (1.5 mm) inside the corners' polygon. The second adds depth -- the plane through the kept
+// contacts' depths lies below it -- so it is kept beside the corners.
+TEST(ReduceManifold, KeepsAnInteriorContactDeeperThanTheFacesPlane) {
+  std::vector<Contact> contacts;
+  for (int i = 0; i <= 10; ++i)
+    for (int j = 0; j <= 10; ++j) contacts.push_back(at(0.1 * i, 0.1 * j, 0.001));
+  contacts.push_back(at(0.3, 0.4, 0.003));
+  contacts.push_back(at(0.7, 0.6, 0.0025));
+  std::vector<double> scratch;
+  const std::size_t n = reduceManifold(contacts, {8, 1e-3}, scratch);
+  ASSERT_GE(n, 6u);
+  EXPECT_EQ(contacts[0].point, Vec3(0.3, 0.4, 0.0));
+  bool secondBump = false;
+  int corners = 0;
+  for (std::size_t i = 1; i < n; ++i) {
+    secondBump = secondBump || contacts[i].point == Vec3(0.7, 0.6, 0.0);
+    corners += std::abs(contacts[i].point.x() - 0.5) > 0.499 && std::abs(contacts[i].point.y() - 0.5) > 0.499;
+  }
+  EXPECT_TRUE(secondBump);
+  EXPECT_EQ(corners, 4);
+}
+
+// Two unit squares overlapping with one turned 45 deg: the overlap is a regular octagon, sampled
+// on a lattice plus its corners, all equally deep. Its eight corners are the support polygon and
+// all eight are kept (each lies outside the polygon of the others).
+TEST(ReduceManifold, KeepsTheEightCornersOfAnOctagonalOverlap) {
+  const double r = 0.5 / std::cos(M_PI / 8);  // circumradius of the octagon of inradius 0.5
+  std::vector<Contact> contacts;
+  auto inside = [&](double x, double y) {
+    return std::abs(x) <= 0.5 && std::abs(y) <= 0.5 && std::abs(x + y) <= 0.5 * std::sqrt(2.0) &&
+           std::abs(x - y) <= 0.5 * std::sqrt(2.0);
+  };
+  for (int i = -10; i <= 10; ++i)
+    for (int j = -10; j <= 10; ++j)
+      if (inside(0.05 * i, 0.05 * j)) contacts.push_back(at(0.05 * i, 0.05 * j, 0.01));
+  for (int k = 0; k < 8; ++k) contacts.push_back(at(r * std::cos(M_PI / 8 + k * M_PI / 4), r * std::sin(M_PI / 8 + k * M_PI / 4), 0.01));
+  std::vector<double> scratch;
+  const std::size_t n = reduceManifold(contacts, {8, 1e-3}, scratch);
+  ASSERT_EQ(n, 8u);
+  for (std::size_t i = 0; i < n; ++i) EXPECT_NEAR(contacts[i].point.norm(), r, 1e-12) << i;
+}
+
 TEST(ReduceManifold, RejectsBadSettings) {
   std::vector<Contact> contacts{at(0, 0, 0)};
   std::vector<double> scratch;
