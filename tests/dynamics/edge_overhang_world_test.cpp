@@ -23,13 +23,8 @@ namespace {
 
 constexpr double kHalf = 0.25;  // the box's half side
 
+using test::solidBoxInertia;
 using test::tiltDegrees;
-
-// A solid box of half sides (a, b, c): m (b^2 + c^2) / 3 about x, and so on.
-Mat3 solidBoxInertia(const Vec3& half, double mass) {
-  const Vec3 sq = half.cwiseProduct(half);
-  return Vec3(sq.y() + sq.z(), sq.x() + sq.z(), sq.x() + sq.y()).asDiagonal() * (mass / 3.0);
-}
 
 struct Support {
   const char* name;

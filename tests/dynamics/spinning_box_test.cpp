@@ -35,8 +35,7 @@ TEST(SpinningBox, StopsWhereItStandsWithEveryModel) {
         RigidBodyDesc d;
         d.shape = box;
         d.mass = 8.0 * half.prod() * 1000.0;
-        const Vec3 sq = half.cwiseProduct(half);
-        d.inertia = (d.mass / 3.0 * Vec3(sq.y() + sq.z(), sq.x() + sq.z(), sq.x() + sq.y())).asDiagonal();
+        d.inertia = test::solidBoxInertia(half, d.mass);
         d.friction = 0.51;
         d.position = Vec3(0.0, 0.0, half.z());
         d.orientation = Quat(Eigen::AngleAxisd(68.1 * M_PI / 180.0, Vec3::UnitZ()));

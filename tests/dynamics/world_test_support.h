@@ -53,6 +53,13 @@ inline double tiltDegrees(const Quat& q) {
 }
 
 /// A unit cube (side 1) baked as above, once per test binary.
+/// The inertia of a solid box of half sides (a, b, c) and `mass`: m (b^2 + c^2) / 3 about x, and
+/// so on.
+inline Mat3 solidBoxInertia(const Vec3& half, double mass) {
+  const Vec3 sq = half.cwiseProduct(half);
+  return Vec3(sq.y() + sq.z(), sq.x() + sq.z(), sq.x() + sq.y()).asDiagonal() * (mass / 3.0);
+}
+
 inline const std::shared_ptr<const CollisionBody>& unitWorldCube() {
   static const std::shared_ptr<const CollisionBody> shape = bakeWorldShape(makeBox(Vec3(0.5, 0.5, 0.5)));
   return shape;
