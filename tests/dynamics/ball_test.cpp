@@ -102,6 +102,7 @@ TEST(Ball, RollsDownASlopeAtFiveSeventhsGSinThetaWithEveryModelAndBudget) {
     for (std::uint64_t budget : {16u, 256u, 0u}) {
       if (sanitized && budget == 256u) continue;
       for (double slopeDeg : {6.0, 15.0}) {
+        if (sanitized && slopeDeg == 6.0) continue;  // one slope under the sanitizers (CI time)
         const Quat slope(Eigen::AngleAxisd(slopeDeg * std::numbers::pi / 180.0, Vec3::UnitY()));
         WorldSettings ws;
         ws.model = model;
