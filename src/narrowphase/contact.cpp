@@ -162,14 +162,15 @@ std::size_t reduceManifold(std::span<Contact> contacts, const ManifoldSettings& 
   // a flat face differ in depth by field noise far below their bounds, and farthest-point picks
   // among them followed that noise, so the load -- and the friction of a box spinning on the
   // floor -- was uneven and the box drifted 12 cm where the exact model's stood still.
+  detail::SupportPolygon polygon(normal, {scratch.data() + 2 * n, polygonRoom});
+  for (std::size_t k = 0; k < kept; ++k) polygon.add(contacts[k]);
   while (kept < settings.maxContacts && kept < n) {
-    detail::SupportPolygon polygon(normal, {scratch.data() + 2 * n, polygonRoom});
-    for (std::size_t k = 0; k < kept; ++k) polygon.add(contacts[k]);
     polygon.close();
     const std::size_t chosen =
         best([&](std::size_t i, double distance) { return polygon.pickScore(contacts[i], distance); });
     if (chosen == n) break;
     keep(chosen);
+    polygon.add(contacts[kept - 1]);
   }
   if (settings.poolNormalsCos <= 1.0 && kept < n) {
     // scratch[kept .. n) are free (distances of the not-kept contacts are recomputed per kept

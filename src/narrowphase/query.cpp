@@ -2771,6 +2771,7 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
   CoherenceCache::Impl* c = cache ? &cache->impl() : nullptr;
   const bool warm = c != nullptr && c->valid && c->a == &a && c->b == &b && c->cells == cells;
   bool finished = false;
+  double sampleMarginAbs = 0.0;  // the contact tree's sample margin this answer uses (below)
   bool exactInterrupted = false;
   double smallestGap = 0.0;  // the traversal's, QueryResult::separation
 
@@ -2860,7 +2861,8 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
     // Samples within the margin of touching are contacts only in a finished answer: an
     // interrupted one's depths are its coarse cells' support points, known only to within their
     // bounds (centimetres on a 1 m box), so "within the margin" says nothing there.
-    if (!finished) sampling.marginAbs = 0.0;
+    sampleMarginAbs = finished ? settings.contactSampling.marginAbs : 0.0;
+    sampling.marginAbs = sampleMarginAbs;
     sampling.maxDepth = kContactTreeLeafDepth;
     sampling.supportPoints = !finished;
     s.sampled.clear();
@@ -2879,7 +2881,7 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
       const std::uint32_t level = std::max(p.a.depth, p.b.depth);
       for (std::size_t i = first; i < s.sampled.size(); ++i) {
         const ContactPoint& cp = s.sampled[i];
-        if (cp.depth < -sampling.marginAbs) continue;
+        if (cp.depth < -sampleMarginAbs) continue;
         Contact ct;
         ct.point = cp.point;
         ct.normal = cp.normal;
@@ -2950,7 +2952,7 @@ void queryContacts(const CollisionBody& a, const Pose& xfWorldFromA, const Colli
                                 settings.budget.answerWithinDeadline && settings.budget.now() >= settings.budget.deadline);
   if (cells && !convexPair && !found && kept >= 2 && answerTimeLeft) {
     extendContactsToRim(a.contactTree(), xfWorldFromA, b.contactTree(), xfWorldFromB, result.contacts,
-                        settings.contactSampling.marginAbs);
+                        sampleMarginAbs);
   }
   std::stable_sort(result.contacts.begin(), result.contacts.end(),
                    [](const Contact& x, const Contact& y) { return x.depth > y.depth; });

@@ -25,7 +25,7 @@ class SupportPolygon {
   void add(const Contact& c);
 
   /// Finishes the polygon: the convex hull of the added contacts and the least-squares plane of
-  /// their depths over it. False where they span no area (fewer than three, or all near one line):
+  /// their depths over it. Contacts may be added after it, and it called again. False where they span no area (fewer than three, or all near one line):
   /// then addsNothing is false for every contact.
   bool close();
 
