@@ -520,7 +520,7 @@ HoldFrame chooseHoldFrame(const Body& a, const Body& b, double overlapAllowed) {
   return best;
 }
 
-bool holdAtBoxes(const Body& a, const Body& b, std::vector<SolverContact>& out) {
+bool holdAtBoxes(const Body& a, const Body& b, double sinkAllowed, std::vector<SolverContact>& out) {
   if (a.invMass == 0.0 && b.invMass == 0.0) return false;
   const double diag = std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal());
   const HoldFrame f = chooseHoldFrame(a, b, kHoldOverlapRel * diag);
@@ -529,14 +529,32 @@ bool holdAtBoxes(const Body& a, const Body& b, std::vector<SolverContact>& out) 
   const Aabb &ba = f.a, &bb = f.b;  // in frame coordinates
   const std::size_t first = out.size();
   const bool alongside = !out.empty();
-  // Beside contacts that every moving body's centre of mass rests within, no hold: they hold it.
-  if (alongside && (a.invMass == 0.0 || withinContacts(out, a.x, f.r, axis)) &&
-      (b.invMass == 0.0 || withinContacts(out, b.x, f.r, axis)))
-    return false;
   const double sign = f.aAbove ? 1.0 : -1.0;  // the normal's sign along the axis
   const Vec3 n = sign * f.r.col(axis);         // out of B toward A, in the world
   const double faceA = f.aAbove ? ba.min[axis] : ba.max[axis];  // A's box face toward B
   const double faceB = f.aAbove ? bb.max[axis] : bb.min[axis];  // B's box face toward A
+  const bool worldFrame = f.r == Mat3::Identity();
+  // Each moving body's support points toward the other box's face (alongside an answer, also
+  // tilted toward the four sides).
+  const std::size_t directions = alongside ? 5 : 1;
+  auto supportsOf = [&](const Body& body, double toward) {
+    return worldFrame ? hullSupports(body, axis, toward, directions)
+                      : supportPoints(body, holdDirections(f.r, axis, toward), directions);
+  };
+  // Beside contacts that a moving body's centre of mass rests within, that body needs no hold:
+  // they hold it -- unless its hull reaches past the other box's face by more than `sinkAllowed`
+  // all the same (its lowest point, support[0]): then the answer's points are not where it
+  // rests. A box thrown at the floor at 16 tests per frame rested on D&O points of its level-1
+  // spheres, above the floor and around its centre of mass, and turned about them until a corner
+  // was 18-22 % of its diagonal below the floor (dos and average; the boxes then overlap on every
+  // axis, where no hold is made).
+  auto restsOnContacts = [&](const Body& body, const Vec3& lowest, double faceOther, double outward) {
+    if (!withinContacts(out, body.x, f.r, axis)) return false;
+    return outward * ((f.r.transpose() * lowest)[axis] - faceOther) >= -sinkAllowed;
+  };
+  if (alongside && (a.invMass == 0.0 || restsOnContacts(a, supportsOf(a, -sign)[0], faceB, sign)) &&
+      (b.invMass == 0.0 || restsOnContacts(b, supportsOf(b, sign)[0], faceA, -sign)))
+    return false;
   // A contact between onA and onB (frame coordinates), one of them on `face`'s box face. That
   // face is there only within its box: a point past it (a box's corner past a table's edge) is
   // not held, or the hold would be a table the box tips over onto.
@@ -565,14 +583,6 @@ bool holdAtBoxes(const Body& a, const Body& b, std::vector<SolverContact>& out) 
     onB[axis] = faceB;
     hold(onA, onB, bb);
   }
-  // Each moving body's support point toward the other box's face (alongside an answer, also
-  // tilted toward the four sides).
-  const std::size_t directions = alongside ? 5 : 1;
-  const bool worldFrame = f.r == Mat3::Identity();
-  auto supportsOf = [&](const Body& body, double toward) {
-    return worldFrame ? hullSupports(body, axis, toward, directions)
-                      : supportPoints(body, holdDirections(f.r, axis, toward), directions);
-  };
   // A support point past the other box's face across the axis is moved onto the face's nearest
   // point, and the body's surface above it taken where it is known (a convex body's face planes):
   // there the face ends, at the edge a box overhanging a table's pivots on. (The hull's corner
@@ -619,9 +629,9 @@ bool holdAtBoxes(const Body& a, const Body& b, std::vector<SolverContact>& out) 
 // coarse contacts (warm-started) lie inside the edge and whose centre of mass lies beyond them,
 // met its edge hold at zero impulse every substep, and the iterations left it turning outward a
 // little each time until it fell.
-bool holdPair(PairState& p, const Body& a, const Body& b) {
+bool holdPair(PairState& p, const Body& a, const Body& b, double sinkAllowed) {
   const std::size_t first = p.contacts.size();
-  if (!holdAtBoxes(a, b, p.contacts)) return false;
+  if (!holdAtBoxes(a, b, sinkAllowed, p.contacts)) return false;
   const double near = 1e-3 * std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal());
   for (std::size_t k = first; k < p.contacts.size(); ++k) {
     SolverContact& cp = p.contacts[k];
@@ -730,6 +740,12 @@ struct World::Impl {
   // at 1,024 tests took 0.54 / 0.77 ms of narrow phase per frame (docs/benchmarks/world.md).
   double microsPerUnit = 0.5;
   std::vector<double> stepTravel;
+
+  // How far a body may reach into the other's hull box beside an interrupted answer before it is
+  // held there (holdAtBoxes): the slop, the depth the solver leaves in place anyway.
+  double sinkAllowed(const Body& a, const Body& b) const {
+    return settings.slopRel * std::min(a.desc.shape->diagonal(), b.desc.shape->diagonal());
+  }
 
   // The broad phase, refused past WorldSettings::maxPairs before the pairs' state is allocated.
   void findPairsWithinLimit(const std::vector<Aabb>& bodyBoxes, const std::vector<std::uint8_t>& isActive,
@@ -1032,7 +1048,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       ++report.pairsSkipped;
       ++p->stale;
       --left;
-      if (p->contacts.empty() || p->interrupted) p->holding = holdPair(*p, a, bb);
+      if (p->contacts.empty() || p->interrupted) p->holding = holdPair(*p, a, bb, sinkAllowed(a, bb));
     };
     // Proven apart (QueryResult::separation, proveApart): no query, no budget, no contacts.
     auto provenApart = [&] {
@@ -1157,7 +1173,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       // came and not the next, turned off them and fell. (Between two moving bodies too, the
       // 200-body bin at 1,024 tests per frame took ~10 % longer per frame.)
       if (p->interrupted && !p->contacts.empty() && (a.invMass == 0.0 || bb.invMass == 0.0))
-        p->holding = holdPair(*p, a, bb);
+        p->holding = holdPair(*p, a, bb, sinkAllowed(a, bb));
       continue;
     }
     // Under a time budget a pair without contacts may be arriving (an empty answer, finished or
@@ -1330,7 +1346,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
           if (cp.c.errorBound > 0.0) cp.c.normal = aSupports ? Vec3(-outOfSupport) : outOfSupport;
     }
     if (p->fresh) persistContacts(*p, a, b, diag);
-    if (p->fresh && p->interrupted && !p->contacts.empty()) p->holding = holdPair(*p, a, b);
+    if (p->fresh && p->interrupted && !p->contacts.empty()) p->holding = holdPair(*p, a, b, sinkAllowed(a, b));
     double maxDepth = 0.0;
     double approach = 0.0;
     // A coarse contact (errorBound > 0: an interrupted sphere-model query) between a moving body
