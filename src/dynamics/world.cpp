@@ -544,9 +544,9 @@ bool holdAtBoxes(const Body& a, const Body& b, double sinkAllowed, std::vector<S
   // Each moving body's support points toward the other box's face (alongside an answer, also
   // tilted toward the four sides).
   const std::size_t directions = alongside ? 5 : 1;
-  auto supportsOf = [&](const Body& body, double toward) {
-    return worldFrame ? hullSupports(body, axis, toward, directions)
-                      : supportPoints(body, holdDirections(f.r, axis, toward), directions);
+  auto supportsOf = [&](const Body& body, double toward, std::size_t count) {
+    return worldFrame ? hullSupports(body, axis, toward, count)
+                      : supportPoints(body, holdDirections(f.r, axis, toward), count);
   };
   // Beside contacts that a moving body's centre of mass rests within, that body needs no hold:
   // they hold it -- unless its hull reaches past the other box's face by more than `sinkAllowed`
@@ -555,12 +555,12 @@ bool holdAtBoxes(const Body& a, const Body& b, double sinkAllowed, std::vector<S
   // spheres, above the floor and around its centre of mass, and turned about them until a corner
   // was 18-22 % of its diagonal below the floor (dos and average; the boxes then overlap on every
   // axis, where no hold is made).
-  auto restsOnContacts = [&](const Body& body, const Vec3& lowest, double faceOther, double outward) {
+  auto restsOnContacts = [&](const Body& body, double outward, double faceOther) {
     if (!withinContacts(out, body.x, f.r, axis)) return false;
+    const Vec3 lowest = supportsOf(body, -outward, 1)[0];
     return outward * ((f.r.transpose() * lowest)[axis] - faceOther) >= -sinkAllowed;
   };
-  if (alongside && (a.invMass == 0.0 || restsOnContacts(a, supportsOf(a, -sign)[0], faceB, sign)) &&
-      (b.invMass == 0.0 || restsOnContacts(b, supportsOf(b, sign)[0], faceA, -sign)))
+  if (alongside && (a.invMass == 0.0 || restsOnContacts(a, sign, faceB)) && (b.invMass == 0.0 || restsOnContacts(b, -sign, faceA)))
     return false;
   // A contact between onA and onB (frame coordinates), one of them on `face`'s box face. That
   // face is there only within its box: a point past it (a box's corner past a table's edge) is
@@ -609,7 +609,7 @@ bool holdAtBoxes(const Body& a, const Body& b, double sinkAllowed, std::vector<S
     return f.r.transpose() * *surface;
   };
   if (a.invMass > 0.0) {
-    const std::array<Vec3, 5> supports = supportsOf(a, -sign);
+    const std::array<Vec3, 5> supports = supportsOf(a, -sign, directions);
     for (std::size_t k = 0; k < directions; ++k) {
       const std::optional<Vec3> onA = onFaceOf(a, supports[k], bb, n);
       if (!onA) continue;
@@ -619,7 +619,7 @@ bool holdAtBoxes(const Body& a, const Body& b, double sinkAllowed, std::vector<S
     }
   }
   if (b.invMass > 0.0) {
-    const std::array<Vec3, 5> supports = supportsOf(b, sign);
+    const std::array<Vec3, 5> supports = supportsOf(b, sign, directions);
     for (std::size_t k = 0; k < directions; ++k) {
       const std::optional<Vec3> onB = onFaceOf(b, supports[k], ba, -n);
       if (!onB) continue;
