@@ -25,7 +25,8 @@ void ballBallAnswer(const Vec3& centreA, double radiusA, const Vec3& centreB, do
 /// the contact's depth and error bound) gives its surface point and outward normal; the contact
 /// takes that normal and the depth that leaves the ball: its radius minus the surface point's
 /// distance from the centre along the normal (negative where the polyhedron overlaps but the ball
-/// does not: a speculative contact). A seed with no surface that near keeps the model's normal.
+/// does not: a speculative contact). A seed with no surface that near keeps the model's normal;
+/// a seed whose surface the ball's centre lies behind takes the surface point nearest the centre.
 /// Contacts whose normals then differ by less than ~3 deg are one contact, the deepest: a ball
 /// touches a face at one point, and the polyhedron's corners on it would be copies of it.
 /// `ballIsA` says which side of the contacts (Contact's convention) the ball is; `other` and
