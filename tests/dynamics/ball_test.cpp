@@ -41,6 +41,24 @@ RigidBodyDesc staticSlab(const std::shared_ptr<const CollisionBody>& slab, const
   return d;
 }
 
+// A world of `model` at `budget` tests per frame holding `slab` (0.25 thick to either side of its
+// middle plane), static, turned to `slope` about the origin, and a ball of `radius` at rest on its
+// top face 4 m up the slope; returns the ball's description (its start).
+RigidBodyDesc ballOnASlope(World& world, const std::shared_ptr<const CollisionBody>& slab, const Quat& slope,
+                           const std::shared_ptr<const CollisionBody>& hull, double radius, double friction) {
+  world.addBody(staticSlab(slab, Pose{slope, Vec3::Zero()}, friction));
+  RigidBodyDesc d = ballDesc(hull, radius);
+  d.friction = friction;
+  d.position = slope * Vec3(-4.0, 0.0, 0.25 + radius);
+  return d;
+}
+
+// How far a solid ball rolling from rest without slipping goes in `seconds`: a t^2 / 2 with
+// a = 5/7 g sin(theta).
+double rollingDistance(double slopeDeg, double seconds) {
+  return 5.0 / 14.0 * kGravity * std::sin(slopeDeg * std::numbers::pi / 180.0) * seconds * seconds;
+}
+
 // Oracle: every face plane's distance from the centre, and every vertex's, by brute force. The
 // hull must hold the ball (planes >= r) and hug it: an icosphere of 2 subdivisions has its most
 // tilted faces' planes at cos 10.9 deg of its circumradius, so its vertices reach 1.81 % beyond.
@@ -108,14 +126,11 @@ TEST(Ball, RollsDownASlopeAtFiveSeventhsGSinThetaWithEveryModelAndBudget) {
         ws.model = model;
         ws.budgetTests = budget;
         World world(ws);
-        world.addBody(staticSlab(slab, Pose{slope, Vec3::Zero()}, 0.8));
-        RigidBodyDesc d = ballDesc(hull, kRadius);
-        d.friction = 0.8;
-        d.position = slope * Vec3(-4.0, 0.0, 0.25 + kRadius);
+        const RigidBodyDesc d = ballOnASlope(world, slab, slope, hull, kRadius, 0.8);
         const BodyId id = world.addBody(d);
         for (int i = 0; i < int(kSeconds * 60); ++i) world.step(1.0 / 60.0);
         const double travelled = (world.state(id).position - d.position).norm();
-        const double expected = 5.0 / 14.0 * kGravity * std::sin(slopeDeg * std::numbers::pi / 180.0) * kSeconds * kSeconds;
+        const double expected = rollingDistance(slopeDeg, kSeconds);
         EXPECT_NEAR(travelled, expected, 0.005 * expected + 0.001)
             << contactModelName(model) << " budget " << budget << " slope " << slopeDeg;
       }
@@ -140,10 +155,7 @@ TEST(Ball, SphereModelsRollItDownASlopeNotThroughIt) {
     ws.model = model;
     ws.budgetTests = 16;
     World world(ws);
-    world.addBody(staticSlab(slab, Pose{slope, Vec3::Zero()}, 0.539));
-    RigidBodyDesc d = ballDesc(hull, kRadius);
-    d.friction = 0.539;
-    d.position = slope * Vec3(-4.0, 0.0, 0.25 + kRadius);
+    const RigidBodyDesc d = ballOnASlope(world, slab, slope, hull, kRadius, 0.539);
     const BodyId id = world.addBody(d);
     double lowest = INFINITY;
     for (int i = 0; i < int(kSeconds * 60); ++i) {
@@ -153,7 +165,7 @@ TEST(Ball, SphereModelsRollItDownASlopeNotThroughIt) {
     const std::string what(contactModelName(model));
     EXPECT_GT(lowest, kRadius - 0.02 * kRadius) << what;
     const double travelled = (world.state(id).position - d.position).norm();
-    const double expected = 5.0 / 14.0 * kGravity * std::sin(kSlopeDeg * std::numbers::pi / 180.0) * kSeconds * kSeconds;
+    const double expected = rollingDistance(kSlopeDeg, kSeconds);
     EXPECT_NEAR(travelled, expected, 0.1 * expected) << what;
   }
 }

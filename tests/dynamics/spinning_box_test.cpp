@@ -6,6 +6,7 @@
 // corners moved on) turned part of that friction into a push: the box drifted 6-12 cm at an
 // unlimited budget (docs/narrow-phase.md, "Manifold").
 #include <cmath>
+#include <memory>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -18,6 +19,32 @@
 
 namespace clod {
 namespace {
+
+// A solid box of half sides `half` (water's density) resting on the floor at z = 0, turned
+// `turnDeg` about the vertical and spinning about it at `spin` rad/s.
+RigidBodyDesc spinningBox(std::shared_ptr<const CollisionBody> shape, const Vec3& half, double turnDeg, double spin,
+                          double friction) {
+  RigidBodyDesc d;
+  d.shape = std::move(shape);
+  d.mass = 8.0 * half.prod() * 1000.0;
+  d.inertia = test::solidBoxInertia(half, d.mass);
+  d.friction = friction;
+  d.position = Vec3(0.0, 0.0, half.z());
+  d.orientation = Quat(Eigen::AngleAxisd(turnDeg * M_PI / 180.0, Vec3::UnitZ()));
+  d.angularVelocity = Vec3(0.0, 0.0, spin);
+  return d;
+}
+
+// Issue 17's resting criteria (moved < 2 cm, tilt < 1 deg, < 5 cm/s), the move horizontally
+// (where the drifts were), and the turn stopped.
+void expectStoppedWhereItStood(const World& world, BodyId id, const RigidBodyDesc& start, const std::string& what) {
+  const RigidBodyState s = world.state(id);
+  const Vec3 moved = s.position - start.position;
+  EXPECT_LT(std::hypot(moved.x(), moved.y()), 0.02) << what;
+  EXPECT_LT(test::tiltDegrees(s.orientation), 1.0) << what;
+  EXPECT_LT(s.velocity.norm(), 0.05) << what;
+  EXPECT_LT(s.angularVelocity.norm(), 0.1) << what;
+}
 
 // A random scene of the probe's `spin` kind (scripts/probe-random-scenes.py, seed 1411): a
 // 0.83 x 0.27 x 0.13 m box turned 68 deg, spinning at 10.9 rad/s on a floor tessellated into
@@ -32,27 +59,13 @@ TEST(SpinningBox, StopsWhereItStandsWithEveryModel) {
       for (const std::uint64_t budget : {std::uint64_t(16), std::uint64_t(256), std::uint64_t(0)}) {
         if (sanitized && (budget == 256 || rate == 240.0)) continue;
         World world = test::staticGroundWorld(model, budget, floor, Vec3(0.0, 0.0, -0.25), Quat::Identity(), 0.51);
-        RigidBodyDesc d;
-        d.shape = box;
-        d.mass = 8.0 * half.prod() * 1000.0;
-        d.inertia = test::solidBoxInertia(half, d.mass);
-        d.friction = 0.51;
-        d.position = Vec3(0.0, 0.0, half.z());
-        d.orientation = Quat(Eigen::AngleAxisd(68.1 * M_PI / 180.0, Vec3::UnitZ()));
-        d.angularVelocity = Vec3(0.0, 0.0, 10.9);
+        const RigidBodyDesc d = spinningBox(box, half, 68.1, 10.9, 0.51);
         const BodyId id = world.addBody(d);
         // The turn stops within ~0.3 s (mu g over the face's mean lever); 0.75 s leaves it at rest.
         for (int i = 0; i < int(0.75 * rate); ++i) world.step(1.0 / rate);
-        const RigidBodyState s = world.state(id);
-        const std::string what = std::string(contactModelName(model)) + " at " + std::to_string(budget) + ", " +
-                                 std::to_string(int(rate)) + " Hz";
-        // Issue 17's resting criteria (moved < 2 cm, tilt < 1 deg, < 5 cm/s): horizontally here,
-        // where the drift was 6-12 cm.
-        const Vec3 moved = s.position - d.position;
-        EXPECT_LT(std::hypot(moved.x(), moved.y()), 0.02) << what;
-        EXPECT_LT(test::tiltDegrees(s.orientation), 1.0) << what;
-        EXPECT_LT(s.velocity.norm(), 0.05) << what;
-        EXPECT_LT(s.angularVelocity.norm(), 0.1) << what;
+        expectStoppedWhereItStood(world, id, d,
+                                  std::string(contactModelName(model)) + " at " + std::to_string(budget) + ", " +
+                                      std::to_string(int(rate)) + " Hz");
       }
 }
 
@@ -70,24 +83,11 @@ TEST(SpinningBox, SphereModelsStopItWhereItStandsAtALimitedBudget) {
     for (const ContactModel model : {ContactModel::kDos, ContactModel::kAverage}) {
       if (sanitized && rate == 240.0) continue;
       World world = test::staticGroundWorld(model, 16, ground, Vec3(0.0, 0.0, -0.25), Quat::Identity(), 0.39);
-      RigidBodyDesc d;
-      d.shape = box;
-      d.mass = 8.0 * half.prod() * 1000.0;
-      d.inertia = test::solidBoxInertia(half, d.mass);
-      d.friction = 0.39;
-      d.position = Vec3(0.0, 0.0, half.z());
-      d.orientation = Quat(Eigen::AngleAxisd(17.3 * M_PI / 180.0, Vec3::UnitZ()));
-      d.angularVelocity = Vec3(0.0, 0.0, 8.56);
+      const RigidBodyDesc d = spinningBox(box, half, 17.3, 8.56, 0.39);
       const BodyId id = world.addBody(d);
       // It stopped within 1.7 s before (drifting all the while); 2 s leaves it at rest.
       for (int i = 0; i < int(2.0 * rate); ++i) world.step(1.0 / rate);
-      const RigidBodyState s = world.state(id);
-      const std::string what = std::string(contactModelName(model)) + " at 16, " + std::to_string(int(rate)) + " Hz";
-      const Vec3 moved = s.position - d.position;
-      EXPECT_LT(std::hypot(moved.x(), moved.y()), 0.02) << what;
-      EXPECT_LT(test::tiltDegrees(s.orientation), 1.0) << what;
-      EXPECT_LT(s.velocity.norm(), 0.05) << what;
-      EXPECT_LT(s.angularVelocity.norm(), 0.1) << what;
+      expectStoppedWhereItStood(world, id, d, std::string(contactModelName(model)) + " at 16, " + std::to_string(int(rate)) + " Hz");
     }
 }
 
