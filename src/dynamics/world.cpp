@@ -9,6 +9,7 @@
 #include <initializer_list>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 
 #include <Eigen/Eigenvalues>
@@ -17,6 +18,7 @@
 #include "clod/quaternion.h"
 #include "clod/query.h"
 #include "dynamics/ball_contacts.h"
+#include "dynamics/hull_points.h"
 #include "narrowphase/separation.h"
 #include "narrowphase/support_polygon.h"
 
@@ -140,7 +142,8 @@ struct Body {
   Mat3 invInertiaLocal = Mat3::Zero();
   Vec3 comLocal = Vec3::Zero();
   Aabb localBox;         // mesh bounds, mesh coordinates
-  Aabb hullLocalBox;     // its hull's box (hullOf), grown by the slack, mesh coordinates
+  Aabb hullLocalBox;     // its hull's box (hullPoints), grown by the slack, mesh coordinates
+  const detail::HullPoints* hullPoints = nullptr;  // its shape's, shared (World::Impl::hulls)
   // A closed convex polyhedron's face planes n . x <= d (mesh coordinates; none for other bodies).
   std::array<Eigen::Vector4d, CollisionBody::kMaxSphereFaceNormals> facePlanes;
   std::uint32_t facePlaneCount = 0;
@@ -272,28 +275,6 @@ std::uint64_t pairKey(BodyId a, BodyId b) { return (std::uint64_t(a) << 32) | b;
 
 // A body's hull: its root patch's extreme vertices (CollisionBody::spherePatchVertices, else
 // sphereSupportVertices, whose support is the hull's to within their slack).
-struct Hull {
-  std::span<const std::uint32_t> vertices;
-  double slack = 0.0;
-};
-Hull hullOf(const CollisionBody& shape) {
-  if (!shape.spherePatchVertices(0).empty()) return {shape.spherePatchVertices(0), 0.0};
-  return {shape.sphereSupportVertices(0), shape.sphereSupportSlack(0)};
-}
-
-// The box of a shape's hull under x -> m x + t, grown by the slack (nullopt: it has no hull).
-std::optional<Aabb> hullBoxUnder(const CollisionBody& shape, const Mat3& m, const Vec3& t) {
-  const Hull hull = hullOf(shape);
-  if (hull.vertices.empty()) return std::nullopt;
-  Aabb box;
-  for (const std::uint32_t v : hull.vertices) box.extend(m * shape.mesh().vertices[v]);
-  box.min += t;
-  box.max += t;
-  box.min.array() -= hull.slack;
-  box.max.array() += hull.slack;
-  return box;
-}
-
 // A body's world box from its hull: the hull's box whatever the body's turn, where the mesh box
 // turned with the body reaches past the hull by up to its corners' lever.
 const Aabb& hullBox(const Body& b) {
@@ -303,13 +284,13 @@ const Aabb& hullBox(const Body& b) {
   c.q = b.q;
   c.haveSupports.fill(0);
   const Pose pose = b.pose();
-  const std::optional<Aabb> box = hullBoxUnder(*b.desc.shape, pose.rotation.toRotationMatrix(), pose.translation);
+  const std::optional<Aabb> box = b.hullPoints->boxUnder(pose.rotation.toRotationMatrix(), pose.translation);
   return c.box = box ? *box : b.worldBox(0.0);
 }
 
 // The hull's box in mesh coordinates: a body's box in its own frame.
-Aabb hullBoxInMesh(const CollisionBody& shape) {
-  return hullBoxUnder(shape, Mat3::Identity(), Vec3::Zero()).value_or(shape.mesh().bounds());
+Aabb hullBoxInMesh(const detail::HullPoints& hull, const CollisionBody& shape) {
+  return hull.boxUnder(Mat3::Identity(), Vec3::Zero()).value_or(shape.mesh().bounds());
 }
 
 // A closed convex polyhedron's face planes (its root patch is the whole body, whose distinct face
@@ -357,7 +338,7 @@ Aabb hullBoxAlong(const Body& b, const Mat3& r) {
   const Pose pose = b.pose();
   const Mat3 m = r.transpose() * pose.rotation.toRotationMatrix();
   const Vec3 t = r.transpose() * pose.translation;
-  if (std::optional<Aabb> box = hullBoxUnder(*b.desc.shape, m, t)) return *box;
+  if (std::optional<Aabb> box = b.hullPoints->boxUnder(m, t)) return *box;
   Aabb box;  // the mesh box's corners
   for (int k = 0; k < 8; ++k) {
     const Vec3 corner((k & 1) ? b.localBox.max.x() : b.localBox.min.x(), (k & 2) ? b.localBox.max.y() : b.localBox.min.y(),
@@ -379,23 +360,17 @@ std::array<Vec3, 5> holdDirections(const Mat3& r, int axis, double sign) {
 // moved on by the slack; the body's box centre where it has no hull. One pass over the hull.
 std::array<Vec3, 5> supportPoints(const Body& b, const std::array<Vec3, 5>& directions, std::size_t count) {
   std::array<Vec3, 5> out;
-  const Hull hull = hullOf(*b.desc.shape);
-  if (hull.vertices.empty()) {
+  const detail::HullPoints& hull = *b.hullPoints;
+  if (hull.empty()) {
     out.fill(b.worldBox(0.0).center());
     return out;
   }
   std::array<Vec3, 5> local;  // in mesh coordinates
-  for (std::size_t k = 0; k < 5; ++k) local[k] = b.q.conjugate() * directions[k];
-  const auto& vertices = b.desc.shape->mesh().vertices;
-  std::array<std::uint32_t, 5> best;
-  std::array<double, 5> reach;
-  best.fill(hull.vertices.front());
-  reach.fill(-std::numeric_limits<double>::infinity());
-  for (const std::uint32_t v : hull.vertices)
-    for (std::size_t k = 0; k < count; ++k)
-      if (const double d = local[k].dot(vertices[v]); d > reach[k]) reach[k] = d, best[k] = v;
+  local.fill(Vec3::Zero());
+  for (std::size_t k = 0; k < count; ++k) local[k] = b.q.conjugate() * directions[k];
+  const std::array<Vec3, 5> farthest = hull.farthestAlong(local, count);
   const Pose pose = b.pose();
-  for (std::size_t k = 0; k < count; ++k) out[k] = pose.apply(vertices[best[k]]) + hull.slack * directions[k];
+  for (std::size_t k = 0; k < count; ++k) out[k] = pose.apply(farthest[k]) + hull.slack() * directions[k];
   return out;
 }
 
@@ -561,7 +536,7 @@ bool holdAtBoxes(const Body& a, const Body& b, double sinkAllowed, std::vector<S
   // axis, where no hold is made).
   auto restsOnContacts = [&](const Body& body, double outward, double faceOther) {
     if (!withinContacts(out, body.x, f.r, axis)) return false;
-    const Vec3 lowest = supportsOf(body, -outward, 1)[0];
+    const Vec3 lowest = supportsOf(body, -outward, directions)[0];  // all five: the hold below needs them
     return outward * ((f.r.transpose() * lowest)[axis] - faceOther) >= -sinkAllowed;
   };
   if (alongside && (a.invMass == 0.0 || restsOnContacts(a, sign, faceB)) && (b.invMass == 0.0 || restsOnContacts(b, -sign, faceA)))
@@ -791,6 +766,14 @@ struct World::Impl {
   // at 1,024 tests took 0.54 / 0.77 ms of narrow phase per frame (docs/benchmarks/world.md).
   double microsPerUnit = 0.5;
   std::vector<double> stepTravel;
+  // Each shape's hull points, shared by its bodies; the map keeps the shape alive, so an address
+  // is never reused by another shape while its entry lives.
+  std::map<std::shared_ptr<const CollisionBody>, std::unique_ptr<const detail::HullPoints>> hulls;
+  const detail::HullPoints* hullPointsOf(const std::shared_ptr<const CollisionBody>& shape) {
+    auto& entry = hulls[shape];
+    if (!entry) entry = std::make_unique<const detail::HullPoints>(*shape);
+    return entry.get();
+  }
 
   // How far a body may reach into the other's hull box beside an interrupted answer before it is
   // held there (holdAtBoxes): the slop, the depth the solver leaves in place anyway.
@@ -930,7 +913,8 @@ BodyId World::addBody(const RigidBodyDesc& d) {
   b.desc.orientation = b.q;
   b.x = d.position + b.q * b.comLocal;
   b.localBox = d.shape->mesh().bounds();
-  b.hullLocalBox = hullBoxInMesh(*d.shape);
+  b.hullPoints = impl_->hullPointsOf(d.shape);
+  b.hullLocalBox = hullBoxInMesh(*b.hullPoints, *d.shape);
   b.facePlaneCount = convexFacePlanes(*d.shape, b.facePlanes);
   b.minExtent = b.localBox.extent().minCoeff();
   b.frameReach = b.localBox.min.cwiseAbs().cwiseMax(b.localBox.max.cwiseAbs()).norm();
@@ -1219,11 +1203,11 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       ++report.pairsReused;
       p->stale = 0;
       --left;
-      // An interrupted answer carried on against an immovable body is held as when it was fresh
-      // (prepare): a box at rest over a table's edge on its roots' contacts, held the substep they
-      // came and not the next, turned off them and fell. (Between two moving bodies too, the
-      // 200-body bin at 1,024 tests per frame took ~10 % longer per frame.)
-      if (p->interrupted && !p->contacts.empty() && (a.invMass == 0.0 || bb.invMass == 0.0))
+      // An interrupted answer carried on is held as when it was fresh (prepare): a box at rest
+      // over a table's edge on its roots' contacts, held the substep they came and not the next,
+      // turned off them and fell; a 1,000 : 1 plate of 1 mm on its thin edge on a light box
+      // turned off its roots' one contact the same way (dos, average; seed 1429's `mass`).
+      if (p->interrupted && !p->contacts.empty())
         p->holding = holdPair(*p, a, bb, sinkAllowed(a, bb));
       continue;
     }
@@ -1769,7 +1753,10 @@ void World::Impl::solve(double h) {
   // 0.006 deg moved so. All the way to the plane, friction's lever there tipped what the coarse
   // points could not hold: a 1,000 : 1 stack of 1 mm boxes at 16 tests per frame moved 1.5-2.9 %
   // of a side (`WorldMassRatio.SphereModelsKeepAHeavyBoxOnALightOneAtLimitedBudgets`, 1 %
-  // allowed). Returns the pair's normal impulse (0: no load, no centre).
+  // allowed). Nor past the answer's contacts to the holds (holdAtBoxes): a 1,000 : 1 plate of
+  // 1 mm on its thin edge, resting on its roots' one D&O contact inside it and held at its boxes,
+  // took friction at its base, below that pivot, and rocked there until it stood 1.1 deg tilted
+  // (dos, 16 tests per frame). Returns the pair's normal impulse (0: no load, no centre).
   auto patchCentre = [&](const PairState& p, const Body& a, Vec3& rA, Vec3& rB) {
     double load = 0.0;
     rA.setZero();
@@ -1786,6 +1773,7 @@ void World::Impl::solve(double h) {
       const Vec3& n = p.patchNormal;
       double lo = 0.0, hi = 0.0;
       for (const SolverContact& cp : p.contacts) {
+        if (cp.hold) continue;
         lo = std::min(lo, n.dot(cp.rA - rA));
         hi = std::max(hi, n.dot(cp.rA - rA));
       }
