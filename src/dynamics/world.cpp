@@ -269,6 +269,9 @@ struct PairState {
   std::uint64_t share = 0;   // the budget the last query was granted before its frontier's (limited budgets)
   Pose queriedAt;
   bool holding = false;      // `contacts` is this substep's hold at the bodies' boxes (holdAtBoxes), no answer
+  // A contact approaches by more than the slop within this substep (a hit, not resting contact):
+  // the pair gets every velocity iteration (solve).
+  bool impact = false;
 };
 
 std::uint64_t pairKey(BodyId a, BodyId b) { return (std::uint64_t(a) << 32) | b; }
@@ -760,6 +763,7 @@ struct World::Impl {
   std::vector<Vec3> savedV, savedW, dV, dW;
   std::map<std::uint64_t, PairReport> pairReports;
   std::uint32_t velocityIterationsNow = 20;
+  bool impactNow = false;  // whether a pair of solveOrder has an impact (PairState::impact)
   // Narrow-phase microseconds per budget unit (test or charged frontier pair), measured with
   // WorldSettings::clock over the time-budgeted steps (exponential average); converts
   // WorldSettings::budgetMicros to units. Starts at 0.5: the 200-body bin's cfm and exact rows
@@ -1341,7 +1345,9 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
 
   // Prepare constraints. Everything that depends on the velocities is read before any
   // warm-start impulse is applied, so it does not depend on the pair order.
+  impactNow = false;
   for (auto& [p, ids] : solveOrder) {
+    p->impact = false;
     Body& a = bodies[ids[0]];
     Body& b = bodies[ids[1]];
     const double restitution = std::max(a.desc.restitution, b.desc.restitution);
@@ -1452,6 +1458,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       cp.targetPos = certain > 0.0 ? std::min(s.correctionFactor * certain, maxCorrection) / h : 0.0;
       maxDepth = std::max(maxDepth, cp.c.depth);
       approach = std::max(approach, -vn);
+      p->impact = p->impact || -vn * h > s.slopRel * diag;
       // Warm start only resting contact: re-applying last substep's impulse to a pair that is now
       // separating or approaching fast (a bounce) adds energy the iterations may not remove.
       const bool resting = std::abs(vn) < s.restitutionThreshold;
@@ -1467,6 +1474,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       cp.lambdaP = 0.0;
     }
     p->priority = approach + maxDepth / h;
+    impactNow = impactNow || p->impact;
     report.solverContacts += p->contacts.size();
   }
   report.prepareSeconds += since(tPrepare);
@@ -1967,35 +1975,51 @@ void World::Impl::solve(double h) {
           apply(bodies[ids[0]], bodies[ids[1]], cp, cp.lambdaN * cp.c.normal + cp.lambdaT1 * cp.t1 + cp.lambdaT2 * cp.t2);
         if (p->patch) warmStartPatch(*p, bodies[ids[0]], bodies[ids[1]]);
       }
-    std::uint32_t used = 0;
-    for (std::uint32_t it = 0; it < velocityIterationsNow; ++it) {
-      ++used;
-      double maxChange = 0.0, maxLambda = 0.0;
-      for (auto& [p, ids] : solveOrder) {
-        Body& a = bodies[ids[0]];
-        Body& b = bodies[ids[1]];
-        const double mu = pairFriction(a, b);
-        if (p->patch) maxChange = std::max(maxChange, patchFrictionStep(*p, a, b, mu, -1.0));
-        for (SolverContact& cp : p->contacts) {
-          // Friction first, limited by the current normal impulse; then the normal, so that
-          // non-penetration, the more important constraint, is solved last (Catto 2005).
-          Vec3 vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
-          if (!p->patch) {
-            const Vec3 friction = frictionStep(cp, vr.dot(cp.t1), vr.dot(cp.t2), cp.tangentK, mu * cp.lambdaN);
-            apply(a, b, cp, friction);
-            maxChange = std::max(maxChange, friction.norm());
-            vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
-          }
-          double old = cp.lambdaN;
-          cp.lambdaN = std::max(0.0, old - cp.massN * (vr.dot(cp.c.normal) + cp.speculative));
-          apply(a, b, cp, (cp.lambdaN - old) * cp.c.normal);
-          maxChange = std::max(maxChange, std::abs(cp.lambdaN - old));
-          maxLambda = std::max(maxLambda, cp.lambdaN);
+    // One Gauss-Seidel pass over a pair: friction first, limited by the current normal impulse;
+    // then the normal, so that non-penetration, the more important constraint, is solved last
+    // (Catto 2005).
+    auto pairPass = [&](PairState& p, const std::array<BodyId, 2>& ids, double& maxChange, double& maxLambda) {
+      Body& a = bodies[ids[0]];
+      Body& b = bodies[ids[1]];
+      const double mu = pairFriction(a, b);
+      if (p.patch) maxChange = std::max(maxChange, patchFrictionStep(p, a, b, mu, -1.0));
+      for (SolverContact& cp : p.contacts) {
+        Vec3 vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
+        if (!p.patch) {
+          const Vec3 friction = frictionStep(cp, vr.dot(cp.t1), vr.dot(cp.t2), cp.tangentK, mu * cp.lambdaN);
+          apply(a, b, cp, friction);
+          maxChange = std::max(maxChange, friction.norm());
+          vr = a.v + a.w.cross(cp.rA) - b.v - b.w.cross(cp.rB);
         }
-        if (rollingRel > 0.0 && !p->contacts.empty()) rollingStep(*p, a, b);
+        double old = cp.lambdaN;
+        cp.lambdaN = std::max(0.0, old - cp.massN * (vr.dot(cp.c.normal) + cp.speculative));
+        apply(a, b, cp, (cp.lambdaN - old) * cp.c.normal);
+        maxChange = std::max(maxChange, std::abs(cp.lambdaN - old));
+        maxLambda = std::max(maxLambda, cp.lambdaN);
       }
-      if (s.convergenceRel > 0.0 && maxChange <= s.convergenceRel * maxLambda) break;
-    }
+      if (rollingRel > 0.0 && !p.contacts.empty()) rollingStep(p, a, b);
+    };
+    // Passes over every pair until converged, at most `iterations`; `impactsOnly`: over the
+    // pairs with an impact this substep (PairState::impact) alone.
+    auto sweep = [&](std::uint32_t iterations, bool impactsOnly) {
+      std::uint32_t used = 0;
+      for (std::uint32_t it = 0; it < iterations; ++it) {
+        ++used;
+        double maxChange = 0.0, maxLambda = 0.0;
+        for (auto& [p, ids] : solveOrder)
+          if (!impactsOnly || p->impact) pairPass(*p, ids, maxChange, maxLambda);
+        if (s.convergenceRel > 0.0 && maxChange <= s.convergenceRel * maxLambda) break;
+      }
+      return used;
+    };
+    std::uint32_t used = sweep(velocityIterationsNow, false);
+    // A step of fast bodies spreads its iterations over its substeps (velocityIterationsNow,
+    // WorldSettings::minSubstepIterations); the pairs of an impact get the rest of
+    // velocityIterations on their own. In 4 iterations the four corners of a box hitting a wall
+    // face-on, each taking the correction first in turn, left it spinning at 1.5 rad/s from
+    // 20 m/s, and it fell 24 cm aside (under 1 mm with all 20). Over every pair, the 200-body
+    // bin's landing frames would run 20 iterations over ~2,300 contacts again.
+    if (impactNow && velocityIterationsNow < s.velocityIterations) used += sweep(s.velocityIterations - velocityIterationsNow, true);
     report.solverIterations += used;
     finalFrictionSweep();
     shockPass();

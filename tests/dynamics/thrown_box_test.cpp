@@ -77,5 +77,49 @@ TEST(ThrownBox, SphereModelsLandItOnTheFloorNotThroughIt) {
   }
 }
 
+// A 10 cm box thrown face-on at a wall at 20 and 100 m/s, 1 m above the floor (restitution 0):
+// it stops at the wall and falls to its foot. Oracle: symmetry -- the wall's face and the box's
+// are parallel and the throw is along their normal, so nothing pushes the box sideways or turns
+// it about the vertical -- and the wall's face (x = 2.95): a box that stopped there stays within
+// its half side of it. A step that fast has many substeps, each with a few velocity iterations
+// (WorldSettings::minSubstepIterations): the four corners of the face, solved in turn, left the
+// box spinning at 1.5 rad/s after a 20 m/s hit, and it landed 24 cm aside (40 cm from 100 m/s,
+// and 45 cm back from the wall); an impact's substep now gets every iteration.
+TEST(ThrownBox, HitFaceOnAtAWallItStopsThereAndFallsToItsFoot) {
+  const auto ground = test::bakeWorldShape(makeBox(Vec3(10.0, 10.0, 0.25)));
+  const auto wall = test::bakeWorldShape(makeBox(Vec3(0.05, 2.0, 2.0)));
+  const auto box = test::bakeWorldShape(makeBox(Vec3::Constant(0.05)));
+  for (const double speed : {20.0, 100.0})
+    for (const ContactModel model :
+         {ContactModel::kCfm, ContactModel::kExact, ContactModel::kContactTree, ContactModel::kDos, ContactModel::kAverage})
+      for (const std::uint64_t budget : {std::uint64_t(16), std::uint64_t(0)}) {
+        World world = test::staticGroundWorld(model, budget, ground, Vec3(0.0, 0.0, -0.25), Quat::Identity(), 0.5);
+        RigidBodyDesc w;
+        w.shape = wall;
+        w.type = BodyType::kStatic;
+        w.position = Vec3(3.0, 0.0, 1.0);
+        w.friction = 0.5;
+        world.addBody(w);
+        RigidBodyDesc d;
+        d.shape = box;
+        d.mass = 1.0;
+        d.inertia = test::solidBoxInertia(Vec3::Constant(0.05), d.mass);
+        d.friction = 0.5;
+        d.position = Vec3(0.0, 0.0, 1.0);
+        d.velocity = Vec3(speed, 0.0, 0.0);
+        const BodyId id = world.addBody(d);
+        for (int i = 0; i < 60; ++i) world.step(1.0 / 60.0);  // 1 s: it lands within 0.5 s
+        const RigidBodyState s = world.state(id);
+        const std::string what = std::string(contactModelName(model)) + " at " + std::to_string(budget) + ", " +
+                                 std::to_string(int(speed)) + " m/s";
+        // Sideways: a tenth of the box's side. Back from the wall: its half side beyond resting
+        // against it (centre at x = 2.9).
+        EXPECT_LT(std::abs(s.position.y()), 0.01) << what;
+        EXPECT_GT(s.position.x(), 2.85) << what;
+        EXPECT_LT(s.position.x(), 2.95) << what;
+        EXPECT_LT(s.position.z(), 0.06) << what;  // on the floor (centre 0.05 above it)
+      }
+}
+
 }  // namespace
 }  // namespace clod
