@@ -757,7 +757,7 @@ struct World::Impl {
   BroadPhaseScratch bpScratch;
   QueryScratch scratch;
   QueryResult result;
-  detail::ContainmentScratch ballScratch;  // putContactsOnBall's field queries
+  detail::ContainmentScratch ballScratch;  // exact-field queries: putContactsOnBall, supports' normals
   std::vector<std::pair<PairState*, std::array<BodyId, 2>>> order;
   std::vector<std::pair<PairState*, std::array<BodyId, 2>>> solveOrder;
   std::vector<Vec3> savedV, savedW, dV, dW;
@@ -1382,9 +1382,26 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
       Vec3 outOfSupport = outwardFromBox(support, other.x);
       if (outOfSupport.squaredNorm() == 0.0 && support.invMass > 0.0) outOfSupport = -outwardFromBox(other, support.x);
       // The contact normal points out of B toward A.
-      if (outOfSupport.squaredNorm() > 0.0)
+      if (outOfSupport.squaredNorm() > 0.0) {
         for (SolverContact& cp : p->contacts)
           if (cp.c.errorBound > 0.0) cp.c.normal = aSupports ? Vec3(-outOfSupport) : outOfSupport;
+      } else if (support.invMass == 0.0 && p->fresh) {
+        // Inside an immovable body's box (a floor with a wall, a bin) that box says nothing, and
+        // the sphere normals pushed bodies sideways: a box over a floor's edge beside a wall slid
+        // off it and fell through (dos and average at 16 tests per frame), boxes sliding on that
+        // floor stuck on its leaf spheres at every budget. There each new contact takes the
+        // support's own surface normal nearest its point (its exact field within the contact's
+        // depth and error bound), kept while the answer is carried on.
+        for (SolverContact& cp : p->contacts) {
+          if (!(cp.c.errorBound > 0.0)) continue;
+          const Pose pose = support.pose();
+          detail::FieldValue f;
+          const double reach = std::abs(cp.c.depth) + cp.c.errorBound;
+          if (!detail::exactBodyFieldWithin(*support.desc.shape, pose.applyInverse(cp.c.point), reach, ballScratch, f)) continue;
+          const Vec3 outward = pose.rotation * f.gradient;
+          cp.c.normal = aSupports ? Vec3(-outward) : outward;
+        }
+      }
     }
     if (p->fresh) persistContacts(*p, a, b, diag);
     if (p->fresh && p->interrupted && !p->contacts.empty()) p->holding = holdPair(*p, a, b, sinkAllowed(a, b));

@@ -55,13 +55,17 @@ TEST(EdgeOverhangWorld, ABoxOverAnEdgeStandsAndOnePastItTipsOffWithEveryModel) {
           // border (docs/contact-tree.md, "Sheets").
           if (past && model == ContactModel::kContactTree && budget != 0) continue;
           // The sphere models' contacts are their spheres': a floor's leaf sphere reaches past its
-          // edge and holds a box 2 cm past it up, and over the L's floor, whose box holds the box's
-          // centre of mass, their normals are D&O's and lean (docs/dynamics.md, "Known limits").
+          // edge and holds a box 2 cm past it up. Over the L's floor, whose box holds the box's
+          // centre of mass, their contacts take the L's own surface normals (docs/dynamics.md,
+          // "Sphere models' interrupted contacts"; D&O's leaned, and the box slid off at every
+          // budget before), but the boxes give no hold: at 16 tests per frame the roots'
+          // contacts lie inside the edge, and the box turns off them (docs/dynamics.md, "Known
+          // limits").
           // Standing over the table's edge is theirs to get right at every budget: at limited ones
           // the roots' contacts lay inside the edge, and the box turned off them until the pair's
           // hold reached the edge (docs/dynamics.md, "Pairs the budget has not reached").
           const bool sphereModel = model == ContactModel::kDos || model == ContactModel::kAverage;
-          if (sphereModel && (past || !support.open)) continue;
+          if (sphereModel && (past || (!support.open && budget == 16))) continue;
           World world = test::staticGroundWorld(model, budget, floor, Vec3::Zero(), Quat::Identity(), 0.6);
           RigidBodyDesc d;
           d.shape = box;
