@@ -1,5 +1,7 @@
 #include "dynamics/hull_points.h"
 
+#include <algorithm>
+#include <cstdint>
 #include <limits>
 
 namespace clod::detail {

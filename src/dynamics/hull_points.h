@@ -1,5 +1,6 @@
 #pragma once
-// A body's hull (the root sphere's patch or support vertices, CollisionBody) as flat coordinate
+// A body's hull -- its root patch's extreme vertices (CollisionBody::spherePatchVertices, else
+// sphereSupportVertices, whose support is the hull's to within their slack) -- as flat coordinate
 // arrays in mesh coordinates, for the world's per-substep scans: the hull's box under a pose and
 // its support points (holds at the bodies' boxes, docs/dynamics.md). The shape lists the hull as
 // indices into its mesh; gathering through them cost ~10 % of a 200-body bin's CPU time.

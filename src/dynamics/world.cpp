@@ -276,8 +276,6 @@ struct PairState {
 
 std::uint64_t pairKey(BodyId a, BodyId b) { return (std::uint64_t(a) << 32) | b; }
 
-// A body's hull: its root patch's extreme vertices (CollisionBody::spherePatchVertices, else
-// sphereSupportVertices, whose support is the hull's to within their slack).
 // A body's world box from its hull: the hull's box whatever the body's turn, where the mesh box
 // turned with the body reaches past the hull by up to its corners' lever.
 const Aabb& hullBox(const Body& b) {
@@ -360,7 +358,7 @@ std::array<Vec3, 5> holdDirections(const Mat3& r, int axis, double sign) {
 }
 
 // The hull's points farthest along the first `count` world directions (its support points),
-// moved on by the slack; the body's box centre where it has no hull. One pass over the hull.
+// moved on by the slack; the body's box centre where it has no hull (HullPoints).
 std::array<Vec3, 5> supportPoints(const Body& b, const std::array<Vec3, 5>& directions, std::size_t count) {
   std::array<Vec3, 5> out;
   const detail::HullPoints& hull = *b.hullPoints;
@@ -1392,9 +1390,9 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
         // floor stuck on its leaf spheres at every budget. There each new contact takes the
         // support's own surface normal nearest its point (its exact field within the contact's
         // depth and error bound), kept while the answer is carried on.
+        const Pose pose = support.pose();
         for (SolverContact& cp : p->contacts) {
           if (!(cp.c.errorBound > 0.0)) continue;
-          const Pose pose = support.pose();
           detail::FieldValue f;
           const double reach = std::abs(cp.c.depth) + cp.c.errorBound;
           if (!detail::exactBodyFieldWithin(*support.desc.shape, pose.applyInverse(cp.c.point), reach, ballScratch, f)) continue;
