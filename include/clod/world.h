@@ -201,8 +201,10 @@ struct WorldSettings {
   /// substeps, ceil(velocityIterations x minSubsteps / n) each but at least this many (and at
   /// most velocityIterations). Smaller steps converge better than more iterations at equal cost
   /// (Macklin et al., SCA 2019, see minSubsteps), and it keeps a fast-moving frame's solver cost
-  /// near a resting frame's instead of n times it (docs/dynamics.md). 0 = velocityIterations in
-  /// every substep (the behaviour before).
+  /// near a resting frame's instead of n times it (docs/dynamics.md). The pairs of an impact (a
+  /// contact approaching by more than the slop within the substep) get the rest of
+  /// velocityIterations in sweeps over them alone (docs/dynamics.md, "One step"). 0 =
+  /// velocityIterations in every substep (the behaviour before).
   std::uint32_t minSubstepIterations = 4;
   /// At least this many substeps per step, in [1, maxSubsteps]. A stack gets more on its own: a
   /// substep per body of its tallest support chain, up to 8, each with velocityIterations --
