@@ -755,7 +755,7 @@ struct World::Impl {
   BroadPhaseScratch bpScratch;
   QueryScratch scratch;
   QueryResult result;
-  detail::ContainmentScratch ballScratch;  // exact-field queries: putContactsOnBall, supports' normals
+  detail::ContainmentScratch fieldScratch;  // exact-field queries: putContactsOnBall, supports' normals
   std::vector<std::pair<PairState*, std::array<BodyId, 2>>> order;
   std::vector<std::pair<PairState*, std::array<BodyId, 2>>> solveOrder;
   std::vector<Vec3> savedV, savedW, dV, dW;
@@ -1144,7 +1144,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
         const Body& ball = ballIsA ? a : bb;
         const Body& other = ballIsA ? bb : a;
         const std::uint32_t fieldQueries = detail::putContactsOnBall(
-            result.contacts, ball.pose().translation, ball.desc.ballRadius, ballIsA, *other.desc.shape, other.pose(), ballScratch);
+            result.contacts, ball.pose().translation, ball.desc.ballRadius, ballIsA, *other.desc.shape, other.pose(), fieldScratch);
         report.testsSpent += fieldQueries;
         report.unitsWorked += fieldQueries;
         pr.tests += fieldQueries;
@@ -1395,7 +1395,7 @@ void World::Impl::substep(double h, bool limited, std::uint64_t allowance, std::
           if (!(cp.c.errorBound > 0.0)) continue;
           detail::FieldValue f;
           const double reach = std::abs(cp.c.depth) + cp.c.errorBound;
-          if (!detail::exactBodyFieldWithin(*support.desc.shape, pose.applyInverse(cp.c.point), reach, ballScratch, f)) continue;
+          if (!detail::exactBodyFieldWithin(*support.desc.shape, pose.applyInverse(cp.c.point), reach, fieldScratch, f)) continue;
           const Vec3 outward = pose.rotation * f.gradient;
           cp.c.normal = aSupports ? Vec3(-outward) : outward;
         }
