@@ -1,7 +1,7 @@
 #pragma once
 // Binary encoding of a contact tree, for the contact-tree section of the bake file.
 //
-// Layout (little-endian, ByteWriter conventions; version 5, docs/bake-format.md has the table):
+// Layout (little-endian, ByteWriter conventions; version 6, docs/bake-format.md has the table):
 //   u32 version, f64 origin[3], f64 rootSize, f64 meshDiagonal, f64 errorAbs, f64 bandAbs,
 //   u32 maxDepth, f32 rootCorners[8], u32 node count, u32 depth count, then one array (u64
 //   count + bytes): the nodes in breadth-first order, range-coded with adaptive binary models
@@ -10,13 +10,15 @@
 //   other node: split bit (not at maxDepth), surface bit, the error code (one bit for the
 //   Lipschitz cap farErrorCode, else its 7 + 4 bits: exponent and 3 mantissa bits); for a split
 //   node its 19 lattice values as integers of ContactTree::valueStep(), each minus the trilinear
-//   prediction from the node's corners; for a surface cell the half-space's octahedral normal
+//   prediction from the node's corners -- but a point on its boundary that a neighbour of the
+//   same depth coded before is one bit, "the same value"; for a surface cell the half-space's octahedral normal
 //   code minus that of the trilinear gradient, its offset (units of halfSpaceStep()) minus the
 //   centre value, and its fit error. Lossless for trees from buildContactTree, which rounds
 //   every value onto these grids (the encoder refuses any other tree with kInvalidArgument).
 //   Versions 1 and 2 (uncompressed arrays of floats), 3 (the first coding, without the cap
-//   bit and the lattice contexts) and 4 (error codes with 7 mantissa bits, normals in steps of
-//   1/32767) are refused with kBakeVersion: re-bake.
+//   bit and the lattice contexts), 4 (error codes with 7 mantissa bits, normals in steps of
+//   1/32767) and 5 (every lattice value coded by every node that holds it) are refused with
+//   kBakeVersion: re-bake.
 
 #include "clod/byte_stream.h"
 #include "clod/contact_tree.h"
@@ -24,7 +26,7 @@
 namespace clod {
 
 /// Version written by encodeContactTree and the only one decodeContactTree accepts.
-inline constexpr std::uint32_t kContactTreeCodecVersion = 5;
+inline constexpr std::uint32_t kContactTreeCodecVersion = 6;
 
 /// Appends `tree` to `out`. The tree must come from buildContactTree or decodeContactTree:
 /// a tree whose shape is inconsistent or whose values are not on the codec's grids (or whose

@@ -1,5 +1,6 @@
 #include "clod/contact_tree_codec.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdlib>
@@ -10,6 +11,7 @@
 #include "clod/error.h"
 #include "half_space_code.h"
 #include "lattice.h"
+#include "position_map.h"
 #include "range_coder.h"
 
 namespace clod {
@@ -68,6 +70,14 @@ struct Models {
   BitModel fitHigh[2][kDepthContexts][128];
   BitModel fitLow[2][8][1 << kFitLowBits];
   BitModel normalFromAncestor[2][2];  // [split][the cell has an ancestor with a half-space]
+  BitModel sharedSame[kDepthContexts];  // a lattice point a neighbour coded holds its value
+  // [split][surface][candidates: 1, 2, 3+]: the error code is one of the neighbours'
+  BitModel errorSame[2][2][3];
+  BitModel errorPick[5][8];  // [candidates - 2]: which one
+  BitModel normalSame[2][3];  // [split][candidates: 1, 2, 3+]
+  BitModel normalPick[5][8];
+  IntModel offsetFromNeighbour[2];
+  IntModel fitFromNeighbour[2];
 };
 
 int depthContext(std::uint32_t depth) { return depth < kDepthContexts ? static_cast<int>(depth) : kDepthContexts - 1; }
@@ -114,6 +124,7 @@ NodeGuess guessNode(const ContactTree& tree, const std::array<float, 8>& corners
 // little between them, so it predicts the node's normal better than the corners do).
 struct LevelCell {
   std::array<float, 8> corners{};
+  std::array<std::uint32_t, 3> at{0, 0, 0};  // integer position on its depth's grid of cells
   std::array<std::int32_t, 2> ancestorNormal{0, 0};
   bool hasAncestorNormal = false;
 };
@@ -125,8 +136,131 @@ void pushChildren(const std::array<float, kLatticeSize>& lattice, const LevelCel
     for (int c = 0; c < 8; ++c) child.corners[c] = lattice[detail::childCornerLattice(o, c)];
     child.ancestorNormal = parent.ancestorNormal;
     child.hasAncestorNormal = parent.hasAncestorNormal;
+    for (int a = 0; a < 3; ++a) child.at[a] = 2 * parent.at[a] + ((o >> a) & 1u);
     next.push_back(child);
   }
+}
+
+// The lattice points of one level that a split node shares with its neighbours of the same
+// depth: the midpoints of its edges and the centres of its faces. Both neighbours store the same
+// value there (the builder rounds the same exact distance against the same prediction: an edge's
+// or a face's trilinear value depends on that edge's or face's corners alone), so the second one
+// codes one bit that says so. In a band of split cells around the surface that is 18 of every
+// node's 19 values stored up to four times. Keys are the points' positions on the level's
+// half-cell grid (cells of depth <= 20: 21 bits per axis).
+class SharedLattice {
+public:
+  void clear() { values_.clear(); }
+  static bool shareable(int l) { return l != 13; }  // every point but the cell's centre
+  static std::uint64_t key(const LevelCell& cell, int l) {
+    const std::uint64_t x = 2u * cell.at[0] + std::uint32_t(l % 3), y = 2u * cell.at[1] + std::uint32_t((l / 3) % 3),
+                        z = 2u * cell.at[2] + std::uint32_t(l / 9);
+    return x | (y << 21) | (z << 42);
+  }
+  const float* find(std::uint64_t key) const { return values_.find(key); }
+  void add(std::uint64_t key, float value) { values_.insert(key, value); }
+
+private:
+  detail::PositionMap<float> values_;
+};
+
+// What a node of the level being coded left for its neighbours: its error code and half-space.
+struct CodedCell {
+  std::uint16_t errorCode = 0;
+  std::uint16_t fitCode = 0;
+  std::array<std::int32_t, 2> normal{0, 0};  // octahedral code
+  float offset = 0.0f;
+  bool hasHalfSpace = false;
+};
+
+// A face neighbour of the same depth coded before the node, and where it lies: the node's
+// position plus `sign` along `axis`.
+struct Neighbour {
+  CodedCell cell;
+  int axis;
+  int sign;
+};
+
+// The coded nodes of one level by position. Neighbours of one surface lie on the same face of a
+// faceted mesh (bunny-1500: 61 % of its surface cells have a coded neighbour whose half-space
+// normal is the node's, to the last bit), so a neighbour predicts the normal exactly, the offset
+// from its plane, and the fit error; error bounds of neighbours often agree too.
+class LevelNeighbours {
+public:
+  void clear() { cells_.clear(); }
+  // Only a node with something to predict: an error code below the cap or a half-space.
+  void add(const LevelCell& cell, const CodedCell& coded, std::uint16_t farCode) {
+    if (coded.hasHalfSpace || coded.errorCode != farCode) cells_.insert(key(cell.at[0], cell.at[1], cell.at[2]), coded);
+  }
+  // The coded face neighbours, in the order -x, -y, -z. A level's nodes are in Morton order
+  // (children follow their parent in octant order), so the +x, +y and +z neighbours always come
+  // later.
+  int gather(const LevelCell& cell, std::array<Neighbour, 3>& out) const {
+    int count = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (cell.at[axis] == 0) continue;
+      std::array<std::uint64_t, 3> p{cell.at[0], cell.at[1], cell.at[2]};
+      --p[axis];
+      if (const CodedCell* c = cells_.find(key(p[0], p[1], p[2]))) out[count++] = {*c, axis, -1};
+    }
+    return count;
+  }
+
+private:
+  static std::uint64_t key(std::uint64_t x, std::uint64_t y, std::uint64_t z) { return x | (y << 21) | (z << 42); }
+  detail::PositionMap<CodedCell> cells_;
+};
+
+// Distinct values among the neighbours (first occurrence kept, in the neighbours' order): the
+// candidates a node's value is picked from.
+template <class Value, class Of>
+int distinctCandidates(const std::array<Neighbour, 3>& nbs, int count, Of of, std::array<Value, 3>& values,
+                       std::array<int, 3>& from) {
+  int n = 0;
+  for (int k = 0; k < count; ++k) {
+    Value v{};
+    if (!of(nbs[k].cell, v)) continue;
+    bool seen = false;
+    for (int i = 0; i < n && !seen; ++i) seen = values[i] == v;
+    if (seen) continue;
+    values[n] = v;
+    from[n++] = k;
+  }
+  return n;
+}
+
+int candidateContext(int n) { return std::min(n, 3) - 1; }
+
+// The offset a neighbour's plane predicts at this node's centre: the plane n.(x - c) = offset of
+// a cell centred at c is n.(x - c') = offset + n.(c - c') at c', and c - c' = sign h e_axis.
+double offsetFromNeighbour(const Neighbour& nb, const std::array<float, 3>& normal, double h) {
+  return double(nb.cell.offset) + nb.sign * h * double(normal[nb.axis]);
+}
+
+// Whether a value is one of n candidates (index, or -1 for none), and which: one adaptive bit,
+// then the index through a tree of models for that n.
+void encodeChoice(detail::RangeEncoder& enc, BitModel& same, BitModel (&pick)[5][8], int n, int index) {
+  enc.encodeBit(same, index >= 0 ? 1u : 0u);
+  if (index >= 0 && n > 1) enc.encodeTree(pick[n - 2], 3, static_cast<std::uint32_t>(index));
+}
+// -1 for none; an index >= n is returned for the caller to refuse.
+int decodeChoice(detail::RangeDecoder& dec, BitModel& same, BitModel (&pick)[5][8], int n) {
+  if (dec.decodeBit(same) == 0) return -1;
+  return n > 1 ? static_cast<int>(dec.decodeTree(pick[n - 2], 3)) : 0;
+}
+
+// The steps from the anchor that a neighbour's plane predicts (bounded: a corrupt stream's
+// neighbour may lie anywhere).
+std::int64_t neighbourUnits(const Neighbour& nb, const std::array<float, 3>& normal, double h, double anchor, double step) {
+  return std::llround(std::clamp((offsetFromNeighbour(nb, normal, h) - anchor) / step, -kMaxUnits, kMaxUnits));
+}
+
+bool sameBits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); }
+
+// The residual a shared value would have had against this node's prediction, for the lattice
+// contexts (bounded: a neighbour's value in a corrupt stream may lie anywhere).
+std::int64_t sharedUnits(float value, double prediction, double step) {
+  return std::llround(std::clamp((double(value) - prediction) / step, -kMaxUnits, kMaxUnits));
 }
 
 [[noreturn]] void refuse(const std::string& what) { throw Error(ErrorCode::kInvalidArgument, "contact tree: " + what); }
@@ -173,9 +307,15 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
   std::vector<LevelCell> level(1), next;
   level[0].corners = tree.rootCorners;
   std::array<float, kLatticeSize> lattice{};
+  SharedLattice shared;
+  LevelNeighbours neighbours;
   for (std::uint32_t d = 0; d < tree.depthCount(); ++d) {
     next.clear();
+    shared.clear();
+    neighbours.clear();
     const int dc = depthContext(d);
+    const double h = tree.cellSize(d);
+    const std::uint16_t farCode = tree.farErrorCode(d);
     const double step = detail::latticeStep(tree, d), hsStep = step / detail::kOffsetStepDivisor;
     for (std::uint32_t j = 0; j < level.size(); ++j) {
       const std::uint32_t node = tree.levelOffsets[d] + j;
@@ -187,35 +327,62 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
       auto bad = [&](const std::string& what) { refuse("node " + std::to_string(node) + ": " + what); };
       if (tree.provenFar(corners, d)) {
         // Derived by the decoder: a proven-far cell is a leaf without a half-space.
-        if (split || hs || code != tree.farErrorCode(d)) bad("its corners prove it far from the surface, but it is split, has a half-space or another error bound");
+        if (split || hs || code != farCode) bad("its corners prove it far from the surface, but it is split, has a half-space or another error bound");
         continue;
       }
       if (d == tree.maxDepth && split) bad("split at maxDepth");
       if (d < tree.maxDepth) enc.encodeBit(models->interior[dc], split ? 1u : 0u);
       const NodeGuess guess = guessNode(tree, corners, d);
       enc.encodeBit(models->surface[split][guess.surfaceBucket][guess.signChange], hs ? 1u : 0u);
-      // The Lipschitz cap (one bit) or the code's two bytes.
-      const bool farCode = code == tree.farErrorCode(d);
-      enc.encodeBit(models->errorFar[split][dc], farCode ? 1u : 0u);
-      if (!farCode) {
+      std::array<Neighbour, 3> nbs{};
+      const int nbCount = neighbours.gather(cell, nbs);
+      CodedCell self{.errorCode = code, .hasHalfSpace = hs != nullptr};
+      // The Lipschitz cap (one bit), one of the neighbours' codes, or the code's two bytes.
+      const bool isFar = code == farCode;
+      enc.encodeBit(models->errorFar[split][dc], isFar ? 1u : 0u);
+      if (!isFar) {
         if (!ContactTree::isCoarseErrorCode(code)) bad("error code is not a finite bound the codec stores");
-        enc.encodeTree(models->errorHigh[split][hs ? 1 : 0][dc], 7, code >> 8);
-        enc.encodeTree(models->errorLow[split][(code >> 8) & 7u], kErrorLowBits, (code & 0xffu) >> kErrorLowShift);
+        std::array<std::uint16_t, 3> codes{};
+        std::array<int, 3> from{};
+        const int count = distinctCandidates(nbs, nbCount, [&](const CodedCell& c, std::uint16_t& v) { v = c.errorCode; return c.errorCode != farCode; }, codes, from);
+        int index = -1;
+        for (int i = 0; i < count && index < 0; ++i)
+          if (codes[i] == code) index = i;
+        if (count > 0) encodeChoice(enc, models->errorSame[split][hs ? 1 : 0][candidateContext(count)], models->errorPick, count, index);
+        if (index < 0) {
+          enc.encodeTree(models->errorHigh[split][hs ? 1 : 0][dc], 7, code >> 8);
+          enc.encodeTree(models->errorLow[split][(code >> 8) & 7u], kErrorLowBits, (code & 0xffu) >> kErrorLowShift);
+        }
       }
 
+      // The neighbour whose half-space normal this node's is, if any: it predicts the offset and
+      // the fit error too.
+      const Neighbour* planeNeighbour = nullptr;
       if (hs) {
         std::array<std::int32_t, 2> oct{};
         if (!detail::findOctCode(hs->normal, oct)) bad("half-space normal is not one the octahedral code stores");
-        // Predicted by the nearest ancestor's normal or by the trilinear gradient, whichever is
-        // closer (one adaptive bit says which).
-        const auto gap = [&](const std::array<std::int32_t, 2>& p) { return std::abs(oct[0] - p[0]) + std::abs(oct[1] - p[1]); };
-        const bool fromAncestor = cell.hasAncestorNormal && gap(cell.ancestorNormal) <= gap(guess.normal);
-        enc.encodeBit(models->normalFromAncestor[split][cell.hasAncestorNormal], fromAncestor ? 1u : 0u);
-        const std::array<std::int32_t, 2> prior = fromAncestor ? cell.ancestorNormal : guess.normal;
-        enc.encodeInt(models->normal[split][0], oct[0] - prior[0]);
-        enc.encodeInt(models->normal[split][1], oct[1] - prior[1]);
+        std::array<std::array<std::int32_t, 2>, 3> normals{};
+        std::array<int, 3> from{};
+        const int count = distinctCandidates(nbs, nbCount, [](const CodedCell& c, std::array<std::int32_t, 2>& v) { v = c.normal; return c.hasHalfSpace; }, normals, from);
+        int index = -1;
+        for (int i = 0; i < count && index < 0; ++i)
+          if (normals[i] == oct) index = i;
+        if (count > 0) encodeChoice(enc, models->normalSame[split][candidateContext(count)], models->normalPick, count, index);
+        if (index >= 0) {
+          planeNeighbour = &nbs[from[index]];
+        } else {
+          // Predicted by the nearest ancestor's normal or by the trilinear gradient, whichever
+          // is closer (one adaptive bit says which).
+          const auto gap = [&](const std::array<std::int32_t, 2>& p) { return std::abs(oct[0] - p[0]) + std::abs(oct[1] - p[1]); };
+          const bool fromAncestor = cell.hasAncestorNormal && gap(cell.ancestorNormal) <= gap(guess.normal);
+          enc.encodeBit(models->normalFromAncestor[split][cell.hasAncestorNormal], fromAncestor ? 1u : 0u);
+          const std::array<std::int32_t, 2> prior = fromAncestor ? cell.ancestorNormal : guess.normal;
+          enc.encodeInt(models->normal[split][0], oct[0] - prior[0]);
+          enc.encodeInt(models->normal[split][1], oct[1] - prior[1]);
+        }
         cell.ancestorNormal = oct;
         cell.hasAncestorNormal = true;
+        self.normal = oct;
       }
       if (split) {
         const std::uint32_t block = (tree.firstChild(node) - 1) / 8;
@@ -223,27 +390,51 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
         for (int l = 0; l < kLatticeSize; ++l) {
           if (kLatticeSlot[l] < 0) continue;
           const float v = tree.lattice[std::size_t{block} * kContactTreeLatticePerNode + kLatticeSlot[l]];
+          const double prediction = detail::latticePrediction(corners, l);
+          lattice[l] = v;
+          if (SharedLattice::shareable(l)) {
+            const std::uint64_t key = SharedLattice::key(cell, l);
+            if (const float* known = shared.find(key)) {
+              const bool same = sameBits(*known, v);
+              enc.encodeBit(models->sharedSame[dc], same ? 1u : 0u);
+              if (same) {
+                activity.add(sharedUnits(v, prediction, step));
+                continue;
+              }
+            } else {
+              shared.add(key, v);
+            }
+          }
           std::int64_t u = 0;
-          if (!unitsOf(v, detail::latticePrediction(corners, l), step, u)) bad("lattice value is not its prediction plus a multiple of the value step");
+          if (!unitsOf(v, prediction, step, u)) bad("lattice value is not its prediction plus a multiple of the value step");
           enc.encodeInt(models->lattice[latticeClass(l)][dc][activity.context()], u);
           activity.add(u);
-          lattice[l] = v;
         }
         for (int c = 0; c < 8; ++c) lattice[detail::parentCornerLattice(c)] = corners[c];
         pushChildren(lattice, cell, next);
       }
       if (hs) {
-        // Offset = -d(centre): predicted by the stored centre value of a split cell, else by
-        // the trilinear value at the centre.
+        // Offset = -d(centre), on the grid anchored at the stored centre value of a split cell,
+        // else at the trilinear value at the centre; where a neighbour has the same normal, its
+        // plane predicts the number of steps.
         std::int64_t offsetUnits = 0;
         std::uint16_t fitCode = 0;
-        if (!unitsOf(hs->offset, detail::offsetPrediction(corners, split, lattice[13]), hsStep, offsetUnits))
+        const double anchor = detail::offsetPrediction(corners, split, lattice[13]);
+        if (!unitsOf(hs->offset, anchor, hsStep, offsetUnits))
           bad("half-space offset is not its prediction plus a multiple of the half-space step");
-        if (!detail::findFitCode(hs->fitError, tree.cellSize(d), fitCode)) bad("half-space fit error is not one the codec stores");
-        enc.encodeInt(models->offset[split], offsetUnits);
-        enc.encodeTree(models->fitHigh[split][dc], 7, fitCode >> 8u);
-        enc.encodeTree(models->fitLow[split][(fitCode >> 8) & 7u], kFitLowBits, (fitCode & 0xffu) >> kFitLowShift);
+        if (!detail::findFitCode(hs->fitError, h, fitCode)) bad("half-space fit error is not one the codec stores");
+        if (planeNeighbour) {
+          enc.encodeInt(models->offsetFromNeighbour[split], offsetUnits - neighbourUnits(*planeNeighbour, hs->normal, h, anchor, hsStep));
+          enc.encodeInt(models->fitFromNeighbour[split], std::int64_t{fitCode} - planeNeighbour->cell.fitCode);
+        } else {
+          enc.encodeInt(models->offset[split], offsetUnits);
+          enc.encodeTree(models->fitHigh[split][dc], 7, fitCode >> 8u);
+          enc.encodeTree(models->fitLow[split][(fitCode >> 8) & 7u], kFitLowBits, (fitCode & 0xffu) >> kFitLowShift);
+        }
+        self.offset = hs->offset;
+        self.fitCode = fitCode;
       }
+      neighbours.add(cell, self, farCode);
     }
     level.swap(next);
   }
@@ -298,18 +489,24 @@ ContactTree decodeContactTree(ByteReader& in) {
   std::vector<LevelCell> level(1), next;
   level[0].corners = tree.rootCorners;
   std::array<float, kLatticeSize> lattice{};
+  SharedLattice shared;
+  LevelNeighbours neighbours;
   std::uint64_t decoded = 0;
   for (std::uint32_t d = 0; !level.empty(); ++d) {
     if (d >= depths) fail("the tree is deeper than its " + std::to_string(depths) + " declared depths");
     if (decoded + level.size() > n) fail("the coded stream holds more than the declared " + std::to_string(n) + " nodes");
     next.clear();
+    shared.clear();
+    neighbours.clear();
     const int dc = depthContext(d);
+    const double h = tree.cellSize(d);
+    const std::uint16_t farCode = tree.farErrorCode(d);
     const double step = detail::latticeStep(tree, d), hsStep = step / detail::kOffsetStepDivisor;
     for (LevelCell& cell : level) {
       const std::array<float, 8>& corners = cell.corners;
       const std::uint64_t node = decoded++;
       if (tree.provenFar(corners, d)) {
-        tree.errorCode.push_back(tree.farErrorCode(d));
+        tree.errorCode.push_back(farCode);
         interiorFlags.push_back(0);
         surfaceFlags.push_back(0);
         continue;
@@ -317,51 +514,100 @@ ContactTree decodeContactTree(ByteReader& in) {
       const bool split = d < tree.maxDepth && dec.decodeBit(models->interior[dc]) != 0;
       const NodeGuess guess = guessNode(tree, corners, d);
       const bool surface = dec.decodeBit(models->surface[split][guess.surfaceBucket][guess.signChange]) != 0;
-      std::uint32_t code = tree.farErrorCode(d);
+      std::array<Neighbour, 3> nbs{};
+      const int nbCount = neighbours.gather(cell, nbs);
+      auto badPick = [&](const char* what) { fail("node " + std::to_string(node) + " picks a neighbour's " + what + " it does not have"); };
+      std::uint32_t code = farCode;
       if (dec.decodeBit(models->errorFar[split][dc]) == 0) {
-        const std::uint32_t high = dec.decodeTree(models->errorHigh[split][surface ? 1 : 0][dc], 7);
-        code = (high << 8) | (dec.decodeTree(models->errorLow[split][high & 7u], kErrorLowBits) << kErrorLowShift);
+        std::array<std::uint16_t, 3> codes{};
+        std::array<int, 3> from{};
+        const int count = distinctCandidates(nbs, nbCount, [&](const CodedCell& c, std::uint16_t& v) { v = c.errorCode; return c.errorCode != farCode; }, codes, from);
+        const int index = count > 0 ? decodeChoice(dec, models->errorSame[split][surface ? 1 : 0][candidateContext(count)], models->errorPick, count) : -1;
+        if (index >= count) badPick("error code");
+        if (index >= 0) {
+          code = codes[index];
+        } else {
+          const std::uint32_t high = dec.decodeTree(models->errorHigh[split][surface ? 1 : 0][dc], 7);
+          code = (high << 8) | (dec.decodeTree(models->errorLow[split][high & 7u], kErrorLowBits) << kErrorLowShift);
+        }
         if (code > ContactTree::kMaxErrorCode) fail("errorCode[" + std::to_string(node) + "] is not a finite bound >= 0");
       }
       tree.errorCode.push_back(static_cast<std::uint16_t>(code));
       interiorFlags.push_back(split ? 1 : 0);
       surfaceFlags.push_back(surface ? 1 : 0);
+      CodedCell self{.errorCode = static_cast<std::uint16_t>(code), .hasHalfSpace = surface};
+      const Neighbour* planeNeighbour = nullptr;
       ContactHalfSpace hs{};
       if (surface) {
-        const bool fromAncestor = dec.decodeBit(models->normalFromAncestor[split][cell.hasAncestorNormal]) != 0;
-        if (fromAncestor && !cell.hasAncestorNormal) fail("node " + std::to_string(node) + " refers to an ancestor normal it does not have");
-        const std::array<std::int32_t, 2> prior = fromAncestor ? cell.ancestorNormal : guess.normal;
-        const std::int64_t a = prior[0] + dec.decodeInt(models->normal[split][0]);
-        const std::int64_t b = prior[1] + dec.decodeInt(models->normal[split][1]);
-        if (std::abs(a) > detail::kOctCodeMax || std::abs(b) > detail::kOctCodeMax) fail("half-space normal code of node " + std::to_string(node) + " is out of range");
-        cell.ancestorNormal = {static_cast<std::int32_t>(a), static_cast<std::int32_t>(b)};
+        std::array<std::array<std::int32_t, 2>, 3> normals{};
+        std::array<int, 3> from{};
+        const int count = distinctCandidates(nbs, nbCount, [](const CodedCell& c, std::array<std::int32_t, 2>& v) { v = c.normal; return c.hasHalfSpace; }, normals, from);
+        const int index = count > 0 ? decodeChoice(dec, models->normalSame[split][candidateContext(count)], models->normalPick, count) : -1;
+        if (index >= count) badPick("normal");
+        if (index >= 0) {
+          planeNeighbour = &nbs[from[index]];
+          cell.ancestorNormal = normals[index];
+        } else {
+          const bool fromAncestor = dec.decodeBit(models->normalFromAncestor[split][cell.hasAncestorNormal]) != 0;
+          if (fromAncestor && !cell.hasAncestorNormal) fail("node " + std::to_string(node) + " refers to an ancestor normal it does not have");
+          const std::array<std::int32_t, 2> prior = fromAncestor ? cell.ancestorNormal : guess.normal;
+          const std::int64_t a = prior[0] + dec.decodeInt(models->normal[split][0]);
+          const std::int64_t b = prior[1] + dec.decodeInt(models->normal[split][1]);
+          if (std::abs(a) > detail::kOctCodeMax || std::abs(b) > detail::kOctCodeMax) fail("half-space normal code of node " + std::to_string(node) + " is out of range");
+          cell.ancestorNormal = {static_cast<std::int32_t>(a), static_cast<std::int32_t>(b)};
+        }
         cell.hasAncestorNormal = true;
+        self.normal = cell.ancestorNormal;
         hs.normal = detail::decodeOctNormal(cell.ancestorNormal[0], cell.ancestorNormal[1]);
       }
       if (split) {
         LatticeActivity activity;
         for (int l = 0; l < kLatticeSize; ++l) {
           if (kLatticeSlot[l] < 0) continue;
+          const double prediction = detail::latticePrediction(corners, l);
+          const float* known = nullptr;
+          std::uint64_t key = 0;
+          if (SharedLattice::shareable(l)) {
+            key = SharedLattice::key(cell, l);
+            known = shared.find(key);
+            if (known && dec.decodeBit(models->sharedSame[dc]) != 0) {
+              lattice[l] = *known;
+              tree.lattice.push_back(*known);
+              activity.add(sharedUnits(*known, prediction, step));
+              continue;
+            }
+          }
           const std::int64_t u = dec.decodeInt(models->lattice[latticeClass(l)][dc][activity.context()]);
           activity.add(u);
-          const float v = detail::storedValue(detail::latticePrediction(corners, l), u, step);
+          const float v = detail::storedValue(prediction, u, step);
           if (!(std::abs(double(u)) < kMaxUnits) || !std::isfinite(v)) fail("lattice value of node " + std::to_string(node) + " is out of range");
           lattice[l] = v;
           tree.lattice.push_back(v);
+          if (SharedLattice::shareable(l) && !known) shared.add(key, v);
         }
         for (int c = 0; c < 8; ++c) lattice[detail::parentCornerLattice(c)] = corners[c];
         pushChildren(lattice, cell, next);
       }
       if (surface) {
-        const std::int64_t offsetUnits = dec.decodeInt(models->offset[split]);
-        const std::uint32_t fitHigh = dec.decodeTree(models->fitHigh[split][dc], 7);
-        const std::uint32_t fitCode = (fitHigh << 8) | (dec.decodeTree(models->fitLow[split][fitHigh & 7u], kFitLowBits) << kFitLowShift);
-        if (!(std::abs(double(offsetUnits)) < kMaxUnits) || fitCode > 0x7f7fu) fail("half-space of node " + std::to_string(node) + " is out of range");
-        hs.offset = detail::storedValue(detail::offsetPrediction(corners, split, lattice[13]), offsetUnits, hsStep);
-        hs.fitError = detail::fitErrorFromCode(static_cast<std::uint16_t>(fitCode), tree.cellSize(d));
+        const double anchor = detail::offsetPrediction(corners, split, lattice[13]);
+        std::int64_t offsetUnits = 0, fitCode = 0;
+        if (planeNeighbour) {
+          offsetUnits = neighbourUnits(*planeNeighbour, hs.normal, h, anchor, hsStep) + dec.decodeInt(models->offsetFromNeighbour[split]);
+          fitCode = planeNeighbour->cell.fitCode + dec.decodeInt(models->fitFromNeighbour[split]);
+        } else {
+          offsetUnits = dec.decodeInt(models->offset[split]);
+          const std::uint32_t fitHigh = dec.decodeTree(models->fitHigh[split][dc], 7);
+          fitCode = (fitHigh << 8) | (dec.decodeTree(models->fitLow[split][fitHigh & 7u], kFitLowBits) << kFitLowShift);
+        }
+        if (!(std::abs(double(offsetUnits)) < kMaxUnits) || fitCode < 0 || fitCode > 0x7f7f) fail("half-space of node " + std::to_string(node) + " is out of range");
+        hs.offset = detail::storedValue(anchor, offsetUnits, hsStep);
+        hs.fitError = detail::fitErrorFromCode(static_cast<std::uint16_t>(fitCode), h);
         if (!std::isfinite(hs.offset) || !std::isfinite(hs.fitError)) fail("half-space of node " + std::to_string(node) + " is not finite");
         tree.halfSpaces.push_back(hs);
+        self.offset = hs.offset;
+        self.fitCode = static_cast<std::uint16_t>(fitCode);
       }
+      neighbours.add(cell, self, farCode);
     }
     tree.levelOffsets.push_back(static_cast<std::uint32_t>(decoded));
     level.swap(next);

@@ -1,4 +1,4 @@
-// The compact contact-tree encoding (codec version 3, docs/bake-format.md): the decoded tree is
+// The compact contact-tree encoding (codec version 6, docs/bake-format.md): the decoded tree is
 // the built tree bit for bit, its field stays within eps_s of a brute-force distance over all
 // triangles, and the stored values are the exact distances rounded by at most half a step.
 
@@ -13,6 +13,7 @@
 
 #include "clod/contact_tree_codec.h"
 #include "clod/error.h"
+#include "contact_tree/lattice.h"
 #include "tree_cache.h"
 
 namespace clod {
@@ -122,6 +123,50 @@ TEST(ContactTreeCompactCodec, StoredLatticeValuesAreTheExactDistanceWithinHalfAS
   EXPECT_GT(checked, 1000u);
 }
 
+// Version 6 codes a lattice point that two split neighbours share once (the second says "the
+// same"), and a half-space normal a face neighbour has as a pick. Neighbours that disagree at a
+// shared point must still come back bit for bit: every third split node of the middle depths
+// gets its +x face centre and an edge midpoint moved by one value step (still on the codec's
+// grid) where only plain leaves use them, so the neighbour on that side holds another value
+// there.
+TEST(ContactTreeCompactCodec, NeighboursThatDisagreeAtASharedPointRoundTripBitForBit) {
+  const auto& built = sharedTree("spot.obj");
+  ContactTree tree = built.tree;
+  std::vector<ContactCell> stack{tree.rootCell()};
+  std::size_t moved = 0, visited = 0;
+  while (!stack.empty()) {
+    const ContactCell cell = stack.back();
+    stack.pop_back();
+    if (tree.isLeaf(cell.node)) continue;
+    for (std::uint32_t o = 0; o < 8; ++o) stack.push_back(tree.childCell(cell, o));
+    if (cell.depth < 3 || cell.depth + 2 > tree.depthCount() || ++visited % 3 != 0) continue;
+    const std::size_t block = (tree.firstChild(cell.node) - 1) / 8;
+    const double step = detail::latticeStep(tree, cell.depth);
+    for (const int l : {14, 5}) {  // (2, 1, 1): the +x face's centre; (2, 1, 0): an edge's midpoint
+      // Only where the children at the point are leaves without a half-space: the rest store
+      // their values relative to their corners, which would no longer be on the grid.
+      bool plainLeaves = true;
+      for (std::uint32_t o = 0; o < 8; ++o) {
+        const bool touches = (o & 1) && (l == 14 || ((o >> 2) & 1) == 0);
+        const ContactCell child = tree.childCell(cell, o);
+        if (touches && (!tree.isLeaf(child.node) || tree.halfSpace(child.node))) plainLeaves = false;
+      }
+      if (!plainLeaves) continue;
+      float& v = tree.lattice[block * kContactTreeLatticePerNode + detail::kLatticeSlot[l]];
+      const double prediction = detail::latticePrediction(cell.corners, l);
+      // Toward 0: no child's corners then prove it far from the surface when they did not.
+      v = detail::storedValue(prediction, detail::residualUnits(v, prediction, step) + (v > 0.0f ? -1 : 1), step);
+      ++moved;
+    }
+  }
+  ASSERT_GT(moved, 300u);
+  const ContactTree decoded = roundTrip(tree);
+  EXPECT_TRUE(sameBytes(decoded.lattice, tree.lattice));
+  EXPECT_TRUE(sameBytes(decoded.halfSpaces, tree.halfSpaces));
+  EXPECT_TRUE(sameBytes(decoded.errorCode, tree.errorCode));
+  EXPECT_TRUE(sameBytes(decoded.nodeWords, tree.nodeWords));
+}
+
 TEST(ContactTreeCompactCodec, EncoderRefusesValuesItCannotStoreExactly) {
   const auto& built = sharedTree("spot.obj");
   auto refused = [](const ContactTree& tree) {
@@ -146,8 +191,9 @@ TEST(ContactTreeCompactCodec, OlderVersionsAskForARebake) {
   const auto& built = sharedTree("spot.obj");
   ByteWriter writer;
   encodeContactTree(built.tree, writer);
-  // 2: the float-array layout; 3: the first coding (no cap bit, no lattice contexts).
-  for (const int version : {2, 3}) {
+  // 2: the float-array layout; 3: the first coding (no cap bit, no lattice contexts); 5: every
+  // lattice value coded by every node that holds it.
+  for (const int version : {2, 3, 5}) {
     std::vector<std::byte> bytes = writer.bytes();
     bytes[0] = std::byte(version);  // the codec's own u32 version, little-endian
     ByteReader reader(bytes.data(), bytes.size(), "old");
