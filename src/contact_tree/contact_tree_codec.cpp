@@ -11,7 +11,6 @@
 #include "clod/error.h"
 #include "half_space_code.h"
 #include "lattice.h"
-#include "position_map.h"
 #include "range_coder.h"
 
 namespace clod {
@@ -73,9 +72,9 @@ struct Models {
   BitModel sharedSame[kDepthContexts];  // a lattice point a neighbour coded holds its value
   // [split][surface][candidates: 1, 2, 3+]: the error code is one of the neighbours'
   BitModel errorSame[2][2][3];
-  BitModel errorPick[5][8];  // [candidates - 2]: which one
+  BitModel errorPick[2][4];  // [candidates - 2]: which one
   BitModel normalSame[2][3];  // [split][candidates: 1, 2, 3+]
-  BitModel normalPick[5][8];
+  BitModel normalPick[2][4];
   IntModel offsetFromNeighbour[2];
   IntModel fitFromNeighbour[2];
 };
@@ -124,44 +123,8 @@ NodeGuess guessNode(const ContactTree& tree, const std::array<float, 8>& corners
 // little between them, so it predicts the node's normal better than the corners do).
 struct LevelCell {
   std::array<float, 8> corners{};
-  std::array<std::uint32_t, 3> at{0, 0, 0};  // integer position on its depth's grid of cells
   std::array<std::int32_t, 2> ancestorNormal{0, 0};
   bool hasAncestorNormal = false;
-};
-
-// The children of a split cell, with corners from its 27 lattice values.
-void pushChildren(const std::array<float, kLatticeSize>& lattice, const LevelCell& parent, std::vector<LevelCell>& next) {
-  for (int o = 0; o < 8; ++o) {
-    LevelCell child;
-    for (int c = 0; c < 8; ++c) child.corners[c] = lattice[detail::childCornerLattice(o, c)];
-    child.ancestorNormal = parent.ancestorNormal;
-    child.hasAncestorNormal = parent.hasAncestorNormal;
-    for (int a = 0; a < 3; ++a) child.at[a] = 2 * parent.at[a] + ((o >> a) & 1u);
-    next.push_back(child);
-  }
-}
-
-// The lattice points of one level that a split node shares with its neighbours of the same
-// depth: the midpoints of its edges and the centres of its faces. Both neighbours store the same
-// value there (the builder rounds the same exact distance against the same prediction: an edge's
-// or a face's trilinear value depends on that edge's or face's corners alone), so the second one
-// codes one bit that says so. In a band of split cells around the surface that is 18 of every
-// node's 19 values stored up to four times. Keys are the points' positions on the level's
-// half-cell grid (cells of depth <= 20: 21 bits per axis).
-class SharedLattice {
-public:
-  void clear() { values_.clear(); }
-  static bool shareable(int l) { return l != 13; }  // every point but the cell's centre
-  static std::uint64_t key(const LevelCell& cell, int l) {
-    const std::uint64_t x = 2u * cell.at[0] + std::uint32_t(l % 3), y = 2u * cell.at[1] + std::uint32_t((l / 3) % 3),
-                        z = 2u * cell.at[2] + std::uint32_t(l / 9);
-    return x | (y << 21) | (z << 42);
-  }
-  const float* find(std::uint64_t key) const { return values_.find(key); }
-  void add(std::uint64_t key, float value) { values_.insert(key, value); }
-
-private:
-  detail::PositionMap<float> values_;
 };
 
 // What a node of the level being coded left for its neighbours: its error code and half-space.
@@ -171,6 +134,7 @@ struct CodedCell {
   std::array<std::int32_t, 2> normal{0, 0};  // octahedral code
   float offset = 0.0f;
   bool hasHalfSpace = false;
+  bool predicts = false;  // coded, with an error code below the cap or a half-space
 };
 
 // A face neighbour of the same depth coded before the node, and where it lies: the node's
@@ -181,34 +145,121 @@ struct Neighbour {
   int sign;
 };
 
-// The coded nodes of one level by position. Neighbours of one surface lie on the same face of a
-// faceted mesh (bunny-1500: 61 % of its surface cells have a coded neighbour whose half-space
-// normal is the node's, to the last bit), so a neighbour predicts the normal exactly, the offset
-// from its plane, and the fit error; error bounds of neighbours often agree too.
-class LevelNeighbours {
+// The nodes of one depth in coding order, with their face neighbours of that depth. A level lists
+// the children of the level above in its order and in octant order, which is Morton order: a
+// node's -x, -y and -z neighbours come before it, the others after. A node's neighbour on a side
+// is its sibling or the child of its parent's neighbour on that side, so the links of a level
+// follow from the level above in O(1) per node.
+//
+// What the neighbours give the codec (version 6): (1) a lattice point on a split node's boundary
+// that a split neighbour coded before holds the same value (the builder rounds the same exact
+// distance against the same prediction: an edge's or a face's trilinear value depends on that
+// edge's or face's corners alone), so it costs one bit; in a band of split cells each node's 18
+// boundary values were coded up to four times. (2) Neighbours of one surface lie on the same
+// face of a faceted mesh (bunny-1500: 61 % of its surface cells have a coded neighbour whose
+// half-space normal is the node's, to the last bit), so a neighbour predicts the normal exactly,
+// the offset from its plane and the fit error; error bounds of neighbours often agree too.
+class Level {
 public:
-  void clear() { cells_.clear(); }
-  // Only a node with something to predict: an error code below the cap or a half-space.
-  void add(const LevelCell& cell, const CodedCell& coded, std::uint16_t farCode) {
-    if (coded.hasHalfSpace || coded.errorCode != farCode) cells_.insert(key(cell.at[0], cell.at[1], cell.at[2]), coded);
+  std::vector<LevelCell> cells;
+
+  static Level root(const std::array<float, 8>& corners) {
+    Level level;
+    level.cells.push_back({corners});
+    level.links_.push_back(kNoLinks);
+    level.startCoding();
+    return level;
   }
-  // The coded face neighbours, in the order -x, -y, -z. A level's nodes are in Morton order
-  // (children follow their parent in octant order), so the +x, +y and +z neighbours always come
-  // later.
-  int gather(const LevelCell& cell, std::array<Neighbour, 3>& out) const {
+  std::size_t size() const { return cells.size(); }
+  bool empty() const { return cells.empty(); }
+
+  // Sizes the per-node records; links_ are already set (root, or linkChildren).
+  void startCoding() {
+    firstChild_.assign(cells.size(), -1);
+    block_.assign(cells.size(), -1);
+    coded_.assign(cells.size(), CodedCell{});
+  }
+  // Node j is split: its lattice block is `block` (index of its 19 values in the tree's pool)
+  // and its children, with corners from the 27 lattice values, go to the next level.
+  void pushChildren(std::size_t j, const LevelCell& cell, const std::array<float, kLatticeSize>& lattice, std::int32_t block,
+                    Level& next) {
+    firstChild_[j] = static_cast<std::int32_t>(next.cells.size());
+    block_[j] = block;
+    for (int o = 0; o < 8; ++o) {
+      LevelCell child;
+      for (int c = 0; c < 8; ++c) child.corners[c] = lattice[detail::childCornerLattice(o, c)];
+      child.ancestorNormal = cell.ancestorNormal;
+      child.hasAncestorNormal = cell.hasAncestorNormal;
+      next.cells.push_back(child);
+    }
+  }
+  void record(std::size_t j, const CodedCell& coded) { coded_[j] = coded; }
+  // The coded face neighbours of node j that have something to predict, in the order -x, -y, -z.
+  int gather(std::size_t j, std::array<Neighbour, 3>& out) const {
     int count = 0;
     for (int axis = 0; axis < 3; ++axis) {
-      if (cell.at[axis] == 0) continue;
-      std::array<std::uint64_t, 3> p{cell.at[0], cell.at[1], cell.at[2]};
-      --p[axis];
-      if (const CodedCell* c = cells_.find(key(p[0], p[1], p[2]))) out[count++] = {*c, axis, -1};
+      const std::int32_t q = links_[j][2 * axis];
+      if (q >= 0 && coded_[q].predicts) out[count++] = {coded_[q], axis, -1};
     }
     return count;
   }
+  // The value that the first split node of this level sharing lattice point l of node j stored
+  // there, if that node was coded before j (`pool`: the tree's lattice values so far).
+  bool sharedValue(std::size_t j, int l, const std::vector<float>& pool, float& value) const {
+    const std::array<int, 3> at{l % 3, (l / 3) % 3, l / 9};
+    std::int64_t first = -1;
+    int firstL = 0;
+    // Offsets -1 / 0 / +1 per axis toward the cells that share the point (0 only where the
+    // point lies in the cell's middle along that axis).
+    for (int dz = at[2] == 0 ? -1 : 0; dz <= (at[2] == 2 ? 1 : 0); ++dz)
+      for (int dy = at[1] == 0 ? -1 : 0; dy <= (at[1] == 2 ? 1 : 0); ++dy)
+        for (int dx = at[0] == 0 ? -1 : 0; dx <= (at[0] == 2 ? 1 : 0); ++dx) {
+          if (dx == 0 && dy == 0 && dz == 0) continue;
+          const std::int64_t q = walk(j, {dx, dy, dz});
+          if (q < 0 || q >= static_cast<std::int64_t>(j) || block_[q] < 0 || (first >= 0 && q >= first)) continue;
+          first = q;
+          firstL = (at[0] - 2 * dx) + 3 * (at[1] - 2 * dy) + 9 * (at[2] - 2 * dz);
+        }
+    if (first < 0) return false;
+    value = pool[std::size_t(block_[first]) * kContactTreeLatticePerNode + std::size_t(detail::kLatticeSlot[firstL])];
+    return true;
+  }
+  // Sets the links of `next` (this level's children) once every node of this level is coded.
+  void linkChildren(Level& next) const {
+    next.links_.assign(next.cells.size(), kNoLinks);
+    for (std::size_t p = 0; p < cells.size(); ++p) {
+      if (firstChild_[p] < 0) continue;
+      for (int o = 0; o < 8; ++o)
+        for (int side = 0; side < 6; ++side) {
+          const int bit = 1 << (side / 2);
+          const bool toSibling = (side % 2 == 0) == ((o & bit) != 0);  // -x side of an x = 1 child, ...
+          const std::int32_t q = toSibling ? static_cast<std::int32_t>(p) : links_[p][side];
+          if (q >= 0 && firstChild_[q] >= 0) next.links_[std::size_t(firstChild_[p] + o)][side] = firstChild_[q] + (o ^ bit);
+        }
+    }
+    next.startCoding();
+  }
 
 private:
-  static std::uint64_t key(std::uint64_t x, std::uint64_t y, std::uint64_t z) { return x | (y << 21) | (z << 42); }
-  detail::PositionMap<CodedCell> cells_;
+  static constexpr std::array<std::int32_t, 6> kNoLinks{-1, -1, -1, -1, -1, -1};
+  // The node at offset d (each -1, 0 or +1) from node j, or -1: along the axes in either order
+  // (a diagonal neighbour may be reachable through one face neighbour and not the other).
+  std::int64_t walk(std::size_t j, const std::array<int, 3>& d) const {
+    for (int order = 0; order < 2; ++order) {
+      std::int64_t q = static_cast<std::int64_t>(j);
+      for (int k = 0; k < 3 && q >= 0; ++k) {
+        const int axis = order == 0 ? k : 2 - k;
+        if (d[axis] != 0) q = links_[std::size_t(q)][2 * axis + (d[axis] > 0)];
+      }
+      if (q >= 0) return q;
+    }
+    return -1;
+  }
+
+  std::vector<std::array<std::int32_t, 6>> links_;  // per node: the neighbour on -x, +x, -y, +y, -z, +z
+  std::vector<std::int32_t> firstChild_;            // per node: its first child's index in the next level
+  std::vector<std::int32_t> block_;                 // per node: its lattice block, -1 if not split
+  std::vector<CodedCell> coded_;
 };
 
 // Distinct values among the neighbours (first occurrence kept, in the neighbours' order): the
@@ -237,16 +288,16 @@ double offsetFromNeighbour(const Neighbour& nb, const std::array<float, 3>& norm
   return double(nb.cell.offset) + nb.sign * h * double(normal[nb.axis]);
 }
 
-// Whether a value is one of n candidates (index, or -1 for none), and which: one adaptive bit,
-// then the index through a tree of models for that n.
-void encodeChoice(detail::RangeEncoder& enc, BitModel& same, BitModel (&pick)[5][8], int n, int index) {
+// Whether a value is one of n <= 3 candidates (index, or -1 for none), and which: one adaptive
+// bit, then the index through a tree of models for that n.
+void encodeChoice(detail::RangeEncoder& enc, BitModel& same, BitModel (&pick)[2][4], int n, int index) {
   enc.encodeBit(same, index >= 0 ? 1u : 0u);
-  if (index >= 0 && n > 1) enc.encodeTree(pick[n - 2], 3, static_cast<std::uint32_t>(index));
+  if (index >= 0 && n > 1) enc.encodeTree(pick[n - 2], 2, static_cast<std::uint32_t>(index));
 }
 // -1 for none; an index >= n is returned for the caller to refuse.
-int decodeChoice(detail::RangeDecoder& dec, BitModel& same, BitModel (&pick)[5][8], int n) {
+int decodeChoice(detail::RangeDecoder& dec, BitModel& same, BitModel (&pick)[2][4], int n) {
   if (dec.decodeBit(same) == 0) return -1;
-  return n > 1 ? static_cast<int>(dec.decodeTree(pick[n - 2], 3)) : 0;
+  return n > 1 ? static_cast<int>(dec.decodeTree(pick[n - 2], 2)) : 0;
 }
 
 // The steps from the anchor that a neighbour's plane predicts (bounded: a corrupt stream's
@@ -304,22 +355,17 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
 
   auto models = std::make_unique<Models>();
   detail::RangeEncoder enc;
-  std::vector<LevelCell> level(1), next;
-  level[0].corners = tree.rootCorners;
+  Level level = Level::root(tree.rootCorners), next;
   std::array<float, kLatticeSize> lattice{};
-  SharedLattice shared;
-  LevelNeighbours neighbours;
   for (std::uint32_t d = 0; d < tree.depthCount(); ++d) {
-    next.clear();
-    shared.clear();
-    neighbours.clear();
+    next.cells.clear();
     const int dc = depthContext(d);
     const double h = tree.cellSize(d);
     const std::uint16_t farCode = tree.farErrorCode(d);
     const double step = detail::latticeStep(tree, d), hsStep = step / detail::kOffsetStepDivisor;
     for (std::uint32_t j = 0; j < level.size(); ++j) {
       const std::uint32_t node = tree.levelOffsets[d] + j;
-      LevelCell cell = level[j];
+      LevelCell cell = level.cells[j];
       const std::array<float, 8>& corners = cell.corners;
       const bool split = !tree.isLeaf(node);
       const ContactHalfSpace* hs = tree.halfSpace(node);
@@ -335,7 +381,7 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
       const NodeGuess guess = guessNode(tree, corners, d);
       enc.encodeBit(models->surface[split][guess.surfaceBucket][guess.signChange], hs ? 1u : 0u);
       std::array<Neighbour, 3> nbs{};
-      const int nbCount = neighbours.gather(cell, nbs);
+      const int nbCount = level.gather(j, nbs);
       CodedCell self{.errorCode = code, .hasHalfSpace = hs != nullptr};
       // The Lipschitz cap (one bit), one of the neighbours' codes, or the code's two bytes.
       const bool isFar = code == farCode;
@@ -392,17 +438,12 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
           const float v = tree.lattice[std::size_t{block} * kContactTreeLatticePerNode + kLatticeSlot[l]];
           const double prediction = detail::latticePrediction(corners, l);
           lattice[l] = v;
-          if (SharedLattice::shareable(l)) {
-            const std::uint64_t key = SharedLattice::key(cell, l);
-            if (const float* known = shared.find(key)) {
-              const bool same = sameBits(*known, v);
-              enc.encodeBit(models->sharedSame[dc], same ? 1u : 0u);
-              if (same) {
-                activity.add(sharedUnits(v, prediction, step));
-                continue;
-              }
-            } else {
-              shared.add(key, v);
+          if (float known = 0.0f; l != 13 && level.sharedValue(j, l, tree.lattice, known)) {
+            const bool same = sameBits(known, v);
+            enc.encodeBit(models->sharedSame[dc], same ? 1u : 0u);
+            if (same) {
+              activity.add(sharedUnits(v, prediction, step));
+              continue;
             }
           }
           std::int64_t u = 0;
@@ -411,7 +452,7 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
           activity.add(u);
         }
         for (int c = 0; c < 8; ++c) lattice[detail::parentCornerLattice(c)] = corners[c];
-        pushChildren(lattice, cell, next);
+        level.pushChildren(j, cell, lattice, static_cast<std::int32_t>(block), next);
       }
       if (hs) {
         // Offset = -d(centre), on the grid anchored at the stored centre value of a split cell,
@@ -434,9 +475,11 @@ void encodeContactTree(const ContactTree& tree, ByteWriter& out) {
         self.offset = hs->offset;
         self.fitCode = fitCode;
       }
-      neighbours.add(cell, self, farCode);
+      self.predicts = self.hasHalfSpace || code != farCode;
+      level.record(j, self);
     }
-    level.swap(next);
+    level.linkChildren(next);
+    std::swap(level, next);
   }
   const std::vector<std::byte> coded = enc.finish();
   out.writeArray(coded);
@@ -486,23 +529,19 @@ ContactTree decodeContactTree(ByteReader& in) {
   surfaceFlags.reserve(n);
   tree.errorCode.reserve(n);
   tree.levelOffsets.push_back(0);
-  std::vector<LevelCell> level(1), next;
-  level[0].corners = tree.rootCorners;
+  Level level = Level::root(tree.rootCorners), next;
   std::array<float, kLatticeSize> lattice{};
-  SharedLattice shared;
-  LevelNeighbours neighbours;
   std::uint64_t decoded = 0;
   for (std::uint32_t d = 0; !level.empty(); ++d) {
     if (d >= depths) fail("the tree is deeper than its " + std::to_string(depths) + " declared depths");
     if (decoded + level.size() > n) fail("the coded stream holds more than the declared " + std::to_string(n) + " nodes");
-    next.clear();
-    shared.clear();
-    neighbours.clear();
+    next.cells.clear();
     const int dc = depthContext(d);
     const double h = tree.cellSize(d);
     const std::uint16_t farCode = tree.farErrorCode(d);
     const double step = detail::latticeStep(tree, d), hsStep = step / detail::kOffsetStepDivisor;
-    for (LevelCell& cell : level) {
+    for (std::size_t j = 0; j < level.size(); ++j) {
+      LevelCell& cell = level.cells[j];
       const std::array<float, 8>& corners = cell.corners;
       const std::uint64_t node = decoded++;
       if (tree.provenFar(corners, d)) {
@@ -515,7 +554,7 @@ ContactTree decodeContactTree(ByteReader& in) {
       const NodeGuess guess = guessNode(tree, corners, d);
       const bool surface = dec.decodeBit(models->surface[split][guess.surfaceBucket][guess.signChange]) != 0;
       std::array<Neighbour, 3> nbs{};
-      const int nbCount = neighbours.gather(cell, nbs);
+      const int nbCount = level.gather(j, nbs);
       auto badPick = [&](const char* what) { fail("node " + std::to_string(node) + " picks a neighbour's " + what + " it does not have"); };
       std::uint32_t code = farCode;
       if (dec.decodeBit(models->errorFar[split][dc]) == 0) {
@@ -565,17 +604,11 @@ ContactTree decodeContactTree(ByteReader& in) {
         for (int l = 0; l < kLatticeSize; ++l) {
           if (kLatticeSlot[l] < 0) continue;
           const double prediction = detail::latticePrediction(corners, l);
-          const float* known = nullptr;
-          std::uint64_t key = 0;
-          if (SharedLattice::shareable(l)) {
-            key = SharedLattice::key(cell, l);
-            known = shared.find(key);
-            if (known && dec.decodeBit(models->sharedSame[dc]) != 0) {
-              lattice[l] = *known;
-              tree.lattice.push_back(*known);
-              activity.add(sharedUnits(*known, prediction, step));
-              continue;
-            }
+          if (float known = 0.0f; l != 13 && level.sharedValue(j, l, tree.lattice, known) && dec.decodeBit(models->sharedSame[dc]) != 0) {
+            lattice[l] = known;
+            tree.lattice.push_back(known);
+            activity.add(sharedUnits(known, prediction, step));
+            continue;
           }
           const std::int64_t u = dec.decodeInt(models->lattice[latticeClass(l)][dc][activity.context()]);
           activity.add(u);
@@ -583,10 +616,9 @@ ContactTree decodeContactTree(ByteReader& in) {
           if (!(std::abs(double(u)) < kMaxUnits) || !std::isfinite(v)) fail("lattice value of node " + std::to_string(node) + " is out of range");
           lattice[l] = v;
           tree.lattice.push_back(v);
-          if (SharedLattice::shareable(l) && !known) shared.add(key, v);
         }
         for (int c = 0; c < 8; ++c) lattice[detail::parentCornerLattice(c)] = corners[c];
-        pushChildren(lattice, cell, next);
+        level.pushChildren(j, cell, lattice, static_cast<std::int32_t>(tree.lattice.size() / kContactTreeLatticePerNode - 1), next);
       }
       if (surface) {
         const double anchor = detail::offsetPrediction(corners, split, lattice[13]);
@@ -607,10 +639,12 @@ ContactTree decodeContactTree(ByteReader& in) {
         self.offset = hs.offset;
         self.fitCode = static_cast<std::uint16_t>(fitCode);
       }
-      neighbours.add(cell, self, farCode);
+      self.predicts = self.hasHalfSpace || code != farCode;
+      level.record(j, self);
     }
     tree.levelOffsets.push_back(static_cast<std::uint32_t>(decoded));
-    level.swap(next);
+    level.linkChildren(next);
+    std::swap(level, next);
   }
   if (decoded != n) fail("the coded stream holds " + std::to_string(decoded) + " nodes, the header declares " + std::to_string(n));
   if (tree.depthCount() != depths) fail("the coded stream holds " + std::to_string(tree.depthCount()) + " depths, the header declares " + std::to_string(depths));
